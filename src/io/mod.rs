@@ -1,0 +1,3 @@
+//! Output: VTU/PVD for ParaView, CSV time histories, PNG plots.
+
+pub mod plot;

@@ -1,0 +1,11 @@
+//! plugsim: explicit total-Lagrangian RKPM simulation of high-speed impact,
+//! plugging and ductile fracture. See `ARCHITECTURE.md` for the module map
+//! and `SPEC.md` (shared) for the physics.
+
+pub mod io;
+pub mod kernel;
+pub mod material;
+pub mod math;
+pub mod particles;
+pub mod quadrature;
+pub mod shape;

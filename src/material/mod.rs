@@ -1,0 +1,128 @@
+//! Constitutive models: the per-quadrature-point stress update (SPEC §6).
+//!
+//! A model is a small pure function `(parameters, old state, rate of
+//! deformation, Δt) → new state`, behind the [`Constitutive`] trait. The
+//! solver only ever sees [`Material`], an enum over the models, so that case
+//! files stay serializable and the hot loop stays monomorphic.
+
+pub mod elastic;
+
+pub use elastic::Elastic;
+
+use crate::math::{Real, Tensor3};
+
+/// State carried by a quadrature point from step to step (SPEC §4).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointState {
+    /// Kirchhoff stress `τ = J σ`, Pa.
+    pub tau: Tensor3,
+    /// Equivalent plastic strain `ε̄`, dimensionless.
+    pub eps_p: Real,
+    /// Equivalent plastic strain rate `ε̄̇` of the last step, 1/s.
+    pub eps_p_rate: Real,
+    /// Temperature, K.
+    pub temperature: Real,
+    /// Johnson–Cook damage `D` (0 = intact, 1 = failed).
+    pub damage: Real,
+}
+
+impl PointState {
+    /// A stress-free, undamaged point at temperature `t0`.
+    pub fn at_rest(t0: Real) -> Self {
+        Self {
+            tau: Tensor3::zeros(),
+            eps_p: 0.0,
+            eps_p_rate: 0.0,
+            temperature: t0,
+            damage: 0.0,
+        }
+    }
+}
+
+/// The kinematic input of one update: rate of deformation `d = sym ℓ`,
+/// spin `w = skw ℓ` (both at mid-step, 1/s) and the step `Δt` (s).
+#[derive(Clone, Copy, Debug)]
+pub struct StepKinematics {
+    pub d: Tensor3,
+    pub w: Tensor3,
+    pub dt: Real,
+}
+
+/// Thermal constants a material provides to heat conduction (SPEC §7).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ThermalProperties {
+    /// Specific heat `C_p`, J/(kg K).
+    pub specific_heat: Real,
+    /// Conductivity `κ`, W/(m K).
+    pub conductivity: Real,
+}
+
+/// What the solver asks of a material at each quadrature point.
+pub trait Constitutive {
+    /// Advance the point's state over one step. Pure: no side effects.
+    fn update(&self, old: &PointState, k: &StepKinematics) -> PointState;
+    /// Reference mass density `ρ₀`, kg/m³.
+    fn density(&self) -> Real;
+    /// Bulk modulus `K`, Pa.
+    fn bulk_modulus(&self) -> Real;
+    /// Shear modulus `G`, Pa.
+    fn shear_modulus(&self) -> Real;
+    /// Initial (room) temperature, K.
+    fn initial_temperature(&self) -> Real;
+    /// Thermal constants, if the model carries them.
+    fn thermal(&self) -> Option<ThermalProperties>;
+    /// Elastic longitudinal (dilatational) wave speed `c_L = sqrt((K + 4G/3)/ρ₀)`,
+    /// the speed that limits the explicit time step (SPEC §5).
+    fn longitudinal_wave_speed(&self) -> Real {
+        ((self.bulk_modulus() + 4.0 * self.shear_modulus() / 3.0) / self.density()).sqrt()
+    }
+}
+
+/// Every constitutive model the solver knows.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Material {
+    /// Hypoelastic, Jaumann rate.
+    Elastic(Elastic),
+}
+
+impl Constitutive for Material {
+    #[inline]
+    fn update(&self, old: &PointState, k: &StepKinematics) -> PointState {
+        match self {
+            Material::Elastic(m) => m.update(old, k),
+        }
+    }
+    fn density(&self) -> Real {
+        match self {
+            Material::Elastic(m) => m.density(),
+        }
+    }
+    fn bulk_modulus(&self) -> Real {
+        match self {
+            Material::Elastic(m) => m.bulk_modulus(),
+        }
+    }
+    fn shear_modulus(&self) -> Real {
+        match self {
+            Material::Elastic(m) => m.shear_modulus(),
+        }
+    }
+    fn initial_temperature(&self) -> Real {
+        match self {
+            Material::Elastic(m) => m.initial_temperature(),
+        }
+    }
+    fn thermal(&self) -> Option<ThermalProperties> {
+        match self {
+            Material::Elastic(m) => m.thermal(),
+        }
+    }
+}
+
+/// Objective (Jaumann) update `τ ← τ + Δt (τ^∇ + w τ − τ w)` (SPEC §6, last
+/// line of the tangent update). The single place where the Jaumann rate is
+/// integrated, shared by every model.
+#[inline]
+pub fn jaumann_update(tau: &Tensor3, tau_rate_objective: &Tensor3, w: &Tensor3, dt: Real) -> Tensor3 {
+    tau + (tau_rate_objective + w * tau - tau * w) * dt
+}

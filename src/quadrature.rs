@@ -1,0 +1,85 @@
+//! The quadrature-point store (SPEC §4): integration points of the background
+//! cells, each with its weight and its material state, struct-of-arrays.
+
+use crate::material::PointState;
+use crate::math::{Real, Tensor3, Vec2};
+
+/// All quadrature points of all bodies. Index `q` in `0..len()`.
+#[derive(Clone, Debug, Default)]
+pub struct QuadraturePoints {
+    /// Reference position `X_q`, m.
+    pub x0: Vec<Vec2>,
+    /// Integration weight `w_q` including the geometry factor
+    /// (cell area × Gauss weight, × 2πR_q in axisymmetry), m³ (m² per unit depth).
+    pub weight: Vec<Real>,
+    /// Body index (selects the material).
+    pub body: Vec<u32>,
+    /// Current deformation gradient `F`.
+    pub f: Vec<Tensor3>,
+    /// Kirchhoff stress `τ`, Pa.
+    pub tau: Vec<Tensor3>,
+    /// Equivalent plastic strain.
+    pub eps_p: Vec<Real>,
+    /// Equivalent plastic strain rate, 1/s.
+    pub eps_p_rate: Vec<Real>,
+    /// Temperature, K.
+    pub temperature: Vec<Real>,
+    /// Johnson–Cook damage.
+    pub damage: Vec<Real>,
+    /// First Piola–Kirchhoff stress times the weight, `P w_q`, cached for the
+    /// force gather, N·m (per unit depth).
+    pub pw: Vec<Tensor3>,
+}
+
+impl QuadraturePoints {
+    pub fn len(&self) -> usize {
+        self.x0.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.x0.is_empty()
+    }
+
+    /// Append a point in the given state.
+    pub fn push(&mut self, x0: Vec2, weight: Real, body: u32, s: &PointState) {
+        self.x0.push(x0);
+        self.weight.push(weight);
+        self.body.push(body);
+        self.f.push(Tensor3::identity());
+        self.tau.push(s.tau);
+        self.eps_p.push(s.eps_p);
+        self.eps_p_rate.push(s.eps_p_rate);
+        self.temperature.push(s.temperature);
+        self.damage.push(s.damage);
+        self.pw.push(Tensor3::zeros());
+    }
+
+    /// The material state of point `q`, gathered from the columns.
+    #[inline]
+    pub fn state(&self, q: usize) -> PointState {
+        PointState {
+            tau: self.tau[q],
+            eps_p: self.eps_p[q],
+            eps_p_rate: self.eps_p_rate[q],
+            temperature: self.temperature[q],
+            damage: self.damage[q],
+        }
+    }
+
+    /// Reorder every column so that new index `k` holds old point `order[k]`.
+    pub fn permute(&mut self, order: &[usize]) {
+        fn p<T: Copy>(v: &mut Vec<T>, order: &[usize]) {
+            let n: Vec<T> = order.iter().map(|&i| v[i]).collect();
+            *v = n;
+        }
+        p(&mut self.x0, order);
+        p(&mut self.weight, order);
+        p(&mut self.body, order);
+        p(&mut self.f, order);
+        p(&mut self.tau, order);
+        p(&mut self.eps_p, order);
+        p(&mut self.eps_p_rate, order);
+        p(&mut self.temperature, order);
+        p(&mut self.damage, order);
+        p(&mut self.pw, order);
+    }
+}

@@ -1,0 +1,5 @@
+//! Reproducing-kernel shape functions (SPEC §3).
+
+pub mod table;
+
+pub use table::ShapeTable;

@@ -1,0 +1,46 @@
+//! Compressed-row storage of shape-function values and gradients.
+
+use crate::math::{Real, Vec2};
+
+/// Shape functions `N_I(X_p)` and gradients `∇_X N_I(X_p)` of a set of
+/// evaluation points `p` (quadrature points, or particles themselves), one
+/// row per point: row `p` holds entries `offsets[p]..offsets[p+1]`, each
+/// naming a particle `index[k]` with value `value[k]` and gradient `grad[k]`.
+/// Computed once in the reference configuration (total Lagrangian) and
+/// patched locally when a crack changes visibility.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ShapeTable {
+    /// Row starts, length `rows + 1`.
+    pub offsets: Vec<usize>,
+    /// Particle index of each entry.
+    pub index: Vec<u32>,
+    /// `N_I(X_p)`.
+    pub value: Vec<Real>,
+    /// `∇_X N_I(X_p)`, 1/m.
+    pub grad: Vec<Vec2>,
+}
+
+impl ShapeTable {
+    /// Number of rows (evaluation points).
+    pub fn rows(&self) -> usize {
+        self.offsets.len().saturating_sub(1)
+    }
+    /// Entry range of row `p`.
+    #[inline]
+    pub fn range(&self, p: usize) -> std::ops::Range<usize> {
+        self.offsets[p]..self.offsets[p + 1]
+    }
+    /// Total number of stored entries.
+    pub fn nnz(&self) -> usize {
+        self.index.len()
+    }
+    /// Interpolate a particle field at evaluation point `p`: `Σ_I N_I(X_p) f_I`.
+    #[inline]
+    pub fn interpolate(&self, p: usize, field: &[Vec2]) -> Vec2 {
+        let mut s = Vec2::zeros();
+        for k in self.range(p) {
+            s += field[self.index[k] as usize] * self.value[k];
+        }
+        s
+    }
+}
