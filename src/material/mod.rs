@@ -126,3 +126,13 @@ impl Constitutive for Material {
 pub fn jaumann_update(tau: &Tensor3, tau_rate_objective: &Tensor3, w: &Tensor3, dt: Real) -> Tensor3 {
     tau + (tau_rate_objective + w * tau - tau * w) * dt
 }
+
+/// A built-in material by name (see `library`), if one exists.
+pub fn builtin(_name: &str) -> Option<Material> {
+    None
+}
+
+/// Names of the built-in materials.
+pub fn builtin_names() -> Vec<&'static str> {
+    Vec::new()
+}

@@ -1,0 +1,605 @@
+//! Case files: one typed TOML format for everything a run needs (SPEC units:
+//! SI throughout). Unknown keys, missing keys and non-physical values are
+//! rejected before the run, each problem naming its key and the file.
+//!
+//! The same structs build cases in tests; [`Case::resolved_toml`] writes the
+//! case with every default expanded, which each run stores beside its output.
+
+use crate::discretize::RectangleGrid;
+use crate::geometry::GeometryMode;
+use crate::material::{Elastic, Material, ThermalProperties};
+use crate::math::{Real, Vec2};
+use crate::model::{BodySetup, Region};
+use crate::step::TimeStepRule;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::fmt;
+use std::path::Path;
+
+/// A whole case.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Case {
+    /// Free-text title shown in the summary.
+    #[serde(default)]
+    pub title: String,
+    /// Geometry mode.
+    pub geometry: GeometrySection,
+    /// Named materials defined in this file (bodies may also name built-ins).
+    #[serde(default)]
+    pub materials: BTreeMap<String, MaterialSpec>,
+    /// Deformable bodies.
+    pub bodies: Vec<BodySpec>,
+    /// Rigid bodies (projectiles, anvils).
+    #[serde(default)]
+    pub rigid_bodies: Vec<RigidBodySpec>,
+    /// Time integration.
+    pub time: TimeSpec,
+    /// Output.
+    #[serde(default)]
+    pub output: OutputSpec,
+}
+
+/// `[geometry]`
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GeometrySection {
+    /// `"plane_strain"` or `"axisymmetric"` (x is then the radius).
+    pub mode: GeometryMode,
+}
+
+/// `[materials.NAME]`: a material model and its constants.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "model", rename_all = "snake_case", deny_unknown_fields)]
+pub enum MaterialSpec {
+    /// Hypoelastic (Jaumann).
+    Elastic {
+        /// Mass density ρ₀, kg/m³.
+        density: Real,
+        /// Young's modulus E, Pa.
+        youngs_modulus: Real,
+        /// Poisson's ratio ν, dimensionless, in (−1, 0.5).
+        poisson_ratio: Real,
+        /// Initial temperature, K. Default 293 K.
+        #[serde(default = "room_temperature")]
+        room_temperature: Real,
+        /// Specific heat C_p, J/(kg K); optional (only for heat conduction).
+        #[serde(default)]
+        specific_heat: Option<Real>,
+        /// Thermal conductivity κ, W/(m K); optional.
+        #[serde(default)]
+        thermal_conductivity: Option<Real>,
+    },
+}
+
+fn room_temperature() -> Real {
+    293.0
+}
+
+/// `[[bodies]]`: a deformable body.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    /// Unique name.
+    pub name: String,
+    /// Name of a material in `[materials]` or a built-in one.
+    pub material: String,
+    /// The body's shape and particle grid.
+    pub rectangle: RectangleGrid,
+    /// Initial velocities, m/s, applied in order (a later region overrides).
+    #[serde(default)]
+    pub initial_velocity: Vec<InitialVelocity>,
+    /// Clamped regions: generalized displacements held at zero. Make them at
+    /// least one support width deep (SPEC §4).
+    #[serde(default)]
+    pub clamps: Vec<Region>,
+}
+
+/// `[[bodies.initial_velocity]]`
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InitialVelocity {
+    /// Velocity (vx, vy), m/s.
+    pub velocity: [Real; 2],
+    /// Region it applies to; the whole body if absent.
+    #[serde(default)]
+    pub region: Option<Region>,
+}
+
+/// `[[rigid_bodies]]`: a rigid body (the projectile).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RigidBodySpec {
+    /// Unique name.
+    pub name: String,
+    /// Closed outline, counter-clockwise, vertices (x, y) in m. Give this or
+    /// `rectangle`.
+    #[serde(default)]
+    pub outline: Option<Vec<[Real; 2]>>,
+    /// A rectangle: `{ center = [x, y], width, height }`, m.
+    #[serde(default)]
+    pub rectangle: Option<RigidRectangle>,
+    /// Mass, kg (per unit depth in plane strain). Give this or `density`.
+    #[serde(default)]
+    pub mass: Option<Real>,
+    /// Density, kg/m³: mass from the area (plane strain) or the volume of
+    /// revolution (axisymmetry).
+    #[serde(default)]
+    pub density: Option<Real>,
+    /// Initial velocity (vx, vy), m/s.
+    pub velocity: [Real; 2],
+    /// Move at `velocity` whatever the forces (a rigid punch or anvil).
+    #[serde(default)]
+    pub prescribed: bool,
+}
+
+/// A rectangular rigid outline.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RigidRectangle {
+    /// Centre (x, y), m.
+    pub center: [Real; 2],
+    /// Extent along x, m.
+    pub width: Real,
+    /// Extent along y, m.
+    pub height: Real,
+}
+
+/// `[time]`
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeSpec {
+    /// End time, s (> 0).
+    pub end: Real,
+    /// CFL safety factor s in `Δt = s · min h / c_L`, in (0, 1]. Default 0.5
+    /// (SPEC §5): half the 1D stability limit leaves room for the 2D
+    /// stencil and the stiffening of compressed material.
+    #[serde(default = "half")]
+    pub safety_factor: Real,
+    /// A fixed step, s, overriding the CFL rule ([RL10] used 4e-9 s).
+    #[serde(default)]
+    pub fixed_dt: Option<Real>,
+}
+
+fn half() -> Real {
+    0.5
+}
+
+/// `[output]`
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Simulated time between VTU snapshots, s. Default: end/50.
+    #[serde(default)]
+    pub interval: Option<Real>,
+    /// Output directory. Default: `runs/<case file stem>`.
+    #[serde(default)]
+    pub directory: Option<String>,
+    /// Point fields written to the VTU files. Default: all of
+    /// [`OUTPUT_FIELDS`].
+    #[serde(default = "all_fields")]
+    pub fields: Vec<String>,
+    /// Write one history (CSV) row every this many steps. Default 10.
+    #[serde(default = "ten")]
+    pub history_every: u64,
+}
+
+fn ten() -> u64 {
+    10
+}
+
+/// Point fields the VTU writer knows.
+pub const OUTPUT_FIELDS: &[&str] = &[
+    "displacement",
+    "velocity",
+    "effective_stress",
+    "pressure",
+    "stress",
+    "plastic_strain",
+    "plastic_strain_rate",
+    "temperature",
+    "damage",
+    "mass",
+    "body",
+    "flags",
+];
+
+fn all_fields() -> Vec<String> {
+    OUTPUT_FIELDS.iter().map(|s| s.to_string()).collect()
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        OutputSpec { interval: None, directory: None, fields: all_fields(), history_every: 10 }
+    }
+}
+
+/// One problem found in a case file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Problem {
+    /// Dotted key, e.g. `bodies[0].rectangle.layers`.
+    pub key: String,
+    pub message: String,
+}
+
+/// Why a case could not be used.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CaseError {
+    /// The file could not be read.
+    Read { file: String, message: String },
+    /// Not valid TOML, a wrong type, an unknown or a missing key.
+    Parse { file: String, message: String },
+    /// A `--set key=value` override could not be applied.
+    Override { file: String, key: String, message: String },
+    /// Values that parse but make no physical sense; all of them at once.
+    Invalid { file: String, problems: Vec<Problem> },
+}
+
+impl fmt::Display for CaseError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CaseError::Read { file, message } => write!(f, "{file}: cannot read case file: {message}"),
+            CaseError::Parse { file, message } => write!(f, "{file}: {}", message.trim_end()),
+            CaseError::Override { file, key, message } => write!(f, "{file}: --set {key}: {message}"),
+            CaseError::Invalid { file, problems } => {
+                write!(f, "{file}: {} problem(s) in the case:", problems.len())?;
+                for p in problems {
+                    write!(f, "\n  {}: {}", p.key, p.message)?;
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+impl std::error::Error for CaseError {}
+
+impl Case {
+    /// Read, override, parse and validate a case file.
+    pub fn load(path: &Path, overrides: &[String]) -> Result<Case, CaseError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| CaseError::Read { file: file.clone(), message: e.to_string() })?;
+        Case::from_str_with(&text, &file, overrides)
+    }
+
+    /// Parse and validate case text; `file` names it in messages.
+    pub fn from_str_with(text: &str, file: &str, overrides: &[String]) -> Result<Case, CaseError> {
+        let mut table: toml::Table =
+            toml::from_str(text).map_err(|e| CaseError::Parse { file: file.to_string(), message: e.to_string() })?;
+        for o in overrides {
+            apply_override(&mut table, o).map_err(|(key, message)| CaseError::Override { file: file.to_string(), key, message })?;
+        }
+        let case: Case = table
+            .try_into()
+            .map_err(|e: toml::de::Error| CaseError::Parse { file: file.to_string(), message: e.to_string() })?;
+        let problems = case.validate();
+        if problems.is_empty() {
+            Ok(case)
+        } else {
+            Err(CaseError::Invalid { file: file.to_string(), problems })
+        }
+    }
+
+    /// All semantic problems, each naming its key.
+    pub fn validate(&self) -> Vec<Problem> {
+        let mut p = Vec::new();
+        let mut add = |key: String, message: String| p.push(Problem { key, message });
+        for (name, m) in &self.materials {
+            let k = format!("materials.{name}");
+            match m {
+                MaterialSpec::Elastic {
+                    density,
+                    youngs_modulus,
+                    poisson_ratio,
+                    room_temperature,
+                    specific_heat,
+                    thermal_conductivity,
+                } => {
+                    positive(&mut add, &format!("{k}.density"), *density, "kg/m^3");
+                    positive(&mut add, &format!("{k}.youngs_modulus"), *youngs_modulus, "Pa");
+                    if !(poisson_ratio.is_finite() && *poisson_ratio > -1.0 && *poisson_ratio < 0.5) {
+                        add(format!("{k}.poisson_ratio"), format!("must lie in (-1, 0.5), got {poisson_ratio}"));
+                    }
+                    positive(&mut add, &format!("{k}.room_temperature"), *room_temperature, "K");
+                    if let Some(c) = specific_heat {
+                        positive(&mut add, &format!("{k}.specific_heat"), *c, "J/(kg K)");
+                    }
+                    if let Some(c) = thermal_conductivity {
+                        non_negative(&mut add, &format!("{k}.thermal_conductivity"), *c, "W/(m K)");
+                    }
+                }
+            }
+        }
+        if self.bodies.is_empty() {
+            add("bodies".into(), "at least one deformable body is needed".into());
+        }
+        let mut names = std::collections::BTreeSet::new();
+        for (b, body) in self.bodies.iter().enumerate() {
+            let k = format!("bodies[{b}]");
+            if !names.insert(body.name.clone()) {
+                add(format!("{k}.name"), format!("duplicate body name '{}'", body.name));
+            }
+            if !self.materials.contains_key(&body.material) && crate::material::builtin(&body.material).is_none() {
+                add(
+                    format!("{k}.material"),
+                    format!(
+                        "unknown material '{}' (defined: [{}]; built-in: [{}])",
+                        body.material,
+                        self.materials.keys().cloned().collect::<Vec<_>>().join(", "),
+                        crate::material::builtin_names().join(", ")
+                    ),
+                );
+            }
+            validate_grid(&mut add, &format!("{k}.rectangle"), &body.rectangle, self.geometry.mode);
+            for (j, iv) in body.initial_velocity.iter().enumerate() {
+                finite2(&mut add, &format!("{k}.initial_velocity[{j}].velocity"), iv.velocity, "m/s");
+                if let Some(r) = &iv.region {
+                    validate_region(&mut add, &format!("{k}.initial_velocity[{j}].region"), r);
+                }
+            }
+            for (j, r) in body.clamps.iter().enumerate() {
+                validate_region(&mut add, &format!("{k}.clamps[{j}]"), r);
+            }
+        }
+        for (r, rb) in self.rigid_bodies.iter().enumerate() {
+            let k = format!("rigid_bodies[{r}]");
+            if !names.insert(rb.name.clone()) {
+                add(format!("{k}.name"), format!("duplicate body name '{}'", rb.name));
+            }
+            match (&rb.outline, &rb.rectangle) {
+                (Some(_), Some(_)) => add(k.clone(), "give either `outline` or `rectangle`, not both".into()),
+                (None, None) => add(k.clone(), "missing the shape: give `outline` or `rectangle`".into()),
+                (Some(o), None) => {
+                    if o.len() < 3 {
+                        add(format!("{k}.outline"), format!("a polygon needs at least 3 vertices, got {}", o.len()));
+                    } else if signed_area(o) <= 0.0 {
+                        add(format!("{k}.outline"), "must be a simple polygon listed counter-clockwise (positive area)".into());
+                    }
+                }
+                (None, Some(rect)) => {
+                    positive(&mut add, &format!("{k}.rectangle.width"), rect.width, "m");
+                    positive(&mut add, &format!("{k}.rectangle.height"), rect.height, "m");
+                }
+            }
+            match (rb.mass, rb.density) {
+                (Some(_), Some(_)) => add(k.clone(), "give either `mass` or `density`, not both".into()),
+                (None, None) if !rb.prescribed => add(k.clone(), "missing `mass` or `density`".into()),
+                (Some(m), None) => positive(&mut add, &format!("{k}.mass"), m, "kg"),
+                (None, Some(d)) => positive(&mut add, &format!("{k}.density"), d, "kg/m^3"),
+                _ => {}
+            }
+            finite2(&mut add, &format!("{k}.velocity"), rb.velocity, "m/s");
+        }
+        positive(&mut add, "time.end", self.time.end, "s");
+        if !(self.time.safety_factor > 0.0 && self.time.safety_factor <= 1.0) {
+            add("time.safety_factor".into(), format!("must lie in (0, 1], got {}", self.time.safety_factor));
+        }
+        if let Some(dt) = self.time.fixed_dt {
+            positive(&mut add, "time.fixed_dt", dt, "s");
+            if dt > self.time.end {
+                add("time.fixed_dt".into(), format!("{dt} s is longer than time.end = {} s", self.time.end));
+            }
+        }
+        if let Some(i) = self.output.interval {
+            positive(&mut add, "output.interval", i, "s");
+        }
+        if self.output.history_every == 0 {
+            add("output.history_every".into(), "must be at least 1".into());
+        }
+        for (j, f) in self.output.fields.iter().enumerate() {
+            if !OUTPUT_FIELDS.contains(&f.as_str()) {
+                add(format!("output.fields[{j}]"), format!("unknown field '{f}' (known: {})", OUTPUT_FIELDS.join(", ")));
+            }
+        }
+        p
+    }
+
+    /// The material named `name`: from this file, else a built-in.
+    pub fn material(&self, name: &str) -> Option<Material> {
+        match self.materials.get(name) {
+            Some(spec) => Some(spec.to_material()),
+            None => crate::material::builtin(name),
+        }
+    }
+
+    /// The case with every default written out (what the run actually used).
+    pub fn resolved(&self) -> Case {
+        let mut c = self.clone();
+        for b in &mut c.bodies {
+            b.rectangle.resolve(c.geometry.mode);
+        }
+        if c.output.interval.is_none() {
+            c.output.interval = Some(c.time.end / 50.0);
+        }
+        c
+    }
+
+    /// TOML text of [`Case::resolved`].
+    pub fn resolved_toml(&self) -> String {
+        toml::to_string_pretty(&self.resolved()).unwrap_or_else(|e| format!("# could not serialize the case: {e}\n"))
+    }
+
+    /// The time-step rule.
+    pub fn time_step_rule(&self) -> TimeStepRule {
+        match self.time.fixed_dt {
+            Some(dt) => TimeStepRule::Fixed(dt),
+            None => TimeStepRule::Cfl { safety: self.time.safety_factor },
+        }
+    }
+
+    /// Inputs of [`crate::model::Model::build`].
+    pub fn body_setups(&self) -> Vec<BodySetup> {
+        self.bodies
+            .iter()
+            .map(|b| BodySetup {
+                name: b.name.clone(),
+                grid: b.rectangle.clone(),
+                material: self.material(&b.material).expect("validated: material exists"),
+                initial_velocity: b
+                    .initial_velocity
+                    .iter()
+                    .map(|iv| (Vec2::new(iv.velocity[0], iv.velocity[1]), iv.region))
+                    .collect(),
+                clamps: b.clamps.clone(),
+            })
+            .collect()
+    }
+}
+
+impl MaterialSpec {
+    /// The solver's material.
+    pub fn to_material(&self) -> Material {
+        match self {
+            MaterialSpec::Elastic {
+                density,
+                youngs_modulus,
+                poisson_ratio,
+                room_temperature,
+                specific_heat,
+                thermal_conductivity,
+            } => Material::Elastic(Elastic {
+                density: *density,
+                youngs_modulus: *youngs_modulus,
+                poisson_ratio: *poisson_ratio,
+                room_temperature: *room_temperature,
+                thermal: match (specific_heat, thermal_conductivity) {
+                    (Some(c), Some(k)) => Some(ThermalProperties { specific_heat: *c, conductivity: *k }),
+                    _ => None,
+                },
+            }),
+        }
+    }
+}
+
+fn positive(add: &mut impl FnMut(String, String), key: &str, v: Real, unit: &str) {
+    if !(v.is_finite() && v > 0.0) {
+        add(key.to_string(), format!("must be a positive number (in {unit}), got {v}"));
+    }
+}
+
+fn non_negative(add: &mut impl FnMut(String, String), key: &str, v: Real, unit: &str) {
+    if !(v.is_finite() && v >= 0.0) {
+        add(key.to_string(), format!("must be zero or positive (in {unit}), got {v}"));
+    }
+}
+
+fn finite2(add: &mut impl FnMut(String, String), key: &str, v: [Real; 2], unit: &str) {
+    if !v.iter().all(|x| x.is_finite()) {
+        add(key.to_string(), format!("must be finite (in {unit}), got {v:?}"));
+    }
+}
+
+fn validate_region(add: &mut impl FnMut(String, String), key: &str, r: &Region) {
+    if !(r.x_min.is_finite() && r.x_max.is_finite() && r.y_min.is_finite() && r.y_max.is_finite()) {
+        add(key.to_string(), "bounds must be finite".into());
+    } else if r.x_max < r.x_min || r.y_max < r.y_min {
+        add(key.to_string(), format!("empty region: x {}..{}, y {}..{}", r.x_min, r.x_max, r.y_min, r.y_max));
+    }
+}
+
+fn validate_grid(add: &mut impl FnMut(String, String), key: &str, g: &RectangleGrid, mode: GeometryMode) {
+    for (name, v) in [("x_min", g.x_min), ("x_max", g.x_max), ("y_min", g.y_min), ("y_max", g.y_max)] {
+        if !v.is_finite() {
+            add(format!("{key}.{name}"), format!("must be finite, got {v}"));
+        }
+    }
+    if !(g.x_max > g.x_min) {
+        add(format!("{key}.x_max"), format!("must exceed x_min (zero or negative length): {} <= {}", g.x_max, g.x_min));
+    }
+    if !(g.y_max > g.y_min) {
+        add(format!("{key}.y_max"), format!("must exceed y_min (zero or negative thickness): {} <= {}", g.y_max, g.y_min));
+    }
+    if mode == GeometryMode::Axisymmetric && g.x_min < 0.0 {
+        add(format!("{key}.x_min"), format!("is a radius in axisymmetry and must be >= 0, got {}", g.x_min));
+    }
+    if g.layers < 2 {
+        add(format!("{key}.layers"), format!("need at least 2 particle rows through the thickness, got {}", g.layers));
+    }
+    if !(g.growth >= 1.0 && g.growth <= 2.0) {
+        add(format!("{key}.growth"), format!("spacing growth ratio must lie in [1, 2], got {}", g.growth));
+    }
+    if !(g.support_factor >= 1.2 && g.support_factor <= 4.0) {
+        add(
+            format!("{key}.support_factor"),
+            format!("must lie in [1.2, 4] (below ~1.2 the bilinear RK basis is singular), got {}", g.support_factor),
+        );
+    }
+    if !(1..=4).contains(&g.gauss) {
+        add(format!("{key}.gauss"), format!("Gauss points per direction must be 1..4, got {}", g.gauss));
+    }
+    if let Some(h) = g.fine_spacing {
+        positive(add, &format!("{key}.fine_spacing"), h, "m");
+    }
+    if let Some(h) = g.coarse_spacing {
+        positive(add, &format!("{key}.coarse_spacing"), h, "m");
+    }
+    if !(g.fine_half_width.is_finite() && g.fine_half_width >= 0.0) {
+        add(format!("{key}.fine_half_width"), format!("must be >= 0 m, got {}", g.fine_half_width));
+    }
+    if let Some(x) = g.refine_at {
+        if !(x >= g.x_min && x <= g.x_max) {
+            add(format!("{key}.refine_at"), format!("must lie in [x_min, x_max], got {x}"));
+        }
+    }
+}
+
+fn signed_area(o: &[[Real; 2]]) -> Real {
+    let n = o.len();
+    (0..n).map(|i| o[i][0] * o[(i + 1) % n][1] - o[(i + 1) % n][0] * o[i][1]).sum::<Real>() * 0.5
+}
+
+/// Apply `key=value` to a TOML table. Keys are dotted paths; a path segment
+/// into an array is an index (`bodies.0.material`) or the `name` of an
+/// element (`bodies.plate.material`). The value is parsed as TOML, or taken
+/// as a string if it does not parse.
+pub fn apply_override(table: &mut toml::Table, assignment: &str) -> Result<(), (String, String)> {
+    let Some((key, raw)) = assignment.split_once('=') else {
+        return Err((assignment.to_string(), "expected key=value".into()));
+    };
+    let key = key.trim();
+    let raw = raw.trim();
+    let value: toml::Value = match toml::from_str::<toml::Table>(&format!("v = {raw}")) {
+        Ok(mut t) => t.remove("v").unwrap_or_else(|| toml::Value::String(raw.to_string())),
+        Err(_) => toml::Value::String(raw.to_string()),
+    };
+    let parts: Vec<&str> = key.split('.').collect();
+    if parts.iter().any(|p| p.is_empty()) {
+        return Err((key.to_string(), "empty path segment".into()));
+    }
+    let mut root = toml::Value::Table(std::mem::take(table));
+    let result = set_path(&mut root, &parts, value).map_err(|m| (key.to_string(), m));
+    if let toml::Value::Table(t) = root {
+        *table = t;
+    }
+    result
+}
+
+fn set_path(cur: &mut toml::Value, parts: &[&str], value: toml::Value) -> Result<(), String> {
+    let (part, rest) = (parts[0], &parts[1..]);
+    let next = match cur {
+        toml::Value::Table(t) => {
+            if rest.is_empty() {
+                t.insert(part.to_string(), value);
+                return Ok(());
+            }
+            t.entry(part.to_string()).or_insert_with(|| toml::Value::Table(toml::Table::new()))
+        }
+        toml::Value::Array(a) => {
+            let idx = match part.parse::<usize>() {
+                Ok(i) if i < a.len() => i,
+                Ok(i) => return Err(format!("index {i} out of range (array has {} elements)", a.len())),
+                Err(_) => a
+                    .iter()
+                    .position(|e| e.get("name").and_then(|n| n.as_str()) == Some(part))
+                    .ok_or_else(|| format!("no element named '{part}'"))?,
+            };
+            if rest.is_empty() {
+                a[idx] = value;
+                return Ok(());
+            }
+            &mut a[idx]
+        }
+        _ => return Err(format!("'{part}' is inside a value that is not a table or array")),
+    };
+    set_path(next, rest, value)
+}

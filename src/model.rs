@@ -1,0 +1,294 @@
+//! The assembled discretization: particles, quadrature points, shape-function
+//! tables and materials of all deformable bodies (SPEC §3–§4).
+
+use crate::discretize::RectangleGrid;
+use crate::geometry::GeometryMode;
+use crate::material::{Constitutive, Material, PointState};
+use crate::math::{Real, Vec2};
+use crate::particles::{ParticleFlags, Particles};
+use crate::quadrature::QuadraturePoints;
+use crate::shape::{build_table, AllVisible, ShapeError, ShapeTable};
+
+/// An axis-aligned box in the reference configuration, used to select
+/// particles (supports, initial-velocity regions).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Region {
+    /// m
+    pub x_min: Real,
+    /// m
+    pub x_max: Real,
+    /// m
+    pub y_min: Real,
+    /// m
+    pub y_max: Real,
+}
+
+impl Region {
+    /// Whether `p` lies in the closed box (with a relative tolerance).
+    pub fn contains(&self, p: &Vec2) -> bool {
+        let tol = 1e-9 * ((self.x_max - self.x_min).abs() + (self.y_max - self.y_min).abs()).max(1e-12);
+        p.x >= self.x_min - tol && p.x <= self.x_max + tol && p.y >= self.y_min - tol && p.y <= self.y_max + tol
+    }
+}
+
+/// What the model builder needs for one deformable body.
+#[derive(Clone, Debug)]
+pub struct BodySetup {
+    pub name: String,
+    pub grid: RectangleGrid,
+    pub material: Material,
+    /// Initial velocity and, optionally, the region it applies to (all if `None`).
+    pub initial_velocity: Vec<(Vec2, Option<Region>)>,
+    /// Clamped regions.
+    pub clamps: Vec<Region>,
+}
+
+/// Per-body bookkeeping.
+#[derive(Clone, Debug)]
+pub struct BodyInfo {
+    pub name: String,
+    /// Particle index range in the store.
+    pub particles: std::ops::Range<usize>,
+    /// Quadrature point index range.
+    pub quad_points: std::ops::Range<usize>,
+    pub columns: usize,
+    pub rows: usize,
+}
+
+/// Transpose of the quadrature shape table: for each particle, the table
+/// entries (and their rows) that involve it, in ascending entry order. The
+/// internal force is a gather over this list, so no two threads ever write
+/// the same particle and sums are bit-identical for any thread count.
+#[derive(Clone, Debug, Default)]
+pub struct Gather {
+    /// Per-particle starts into `entry`, length `particles + 1`.
+    pub offsets: Vec<usize>,
+    /// Entry index `k` into the quadrature table.
+    pub entry: Vec<u32>,
+    /// Quadrature point (row) of that entry.
+    pub point: Vec<u32>,
+}
+
+impl Gather {
+    /// Build from a table whose column indices are particles `0..n`.
+    pub fn new(table: &ShapeTable, n: usize) -> Self {
+        let mut offsets = vec![0usize; n + 1];
+        for &i in &table.index {
+            offsets[i as usize + 1] += 1;
+        }
+        for i in 0..n {
+            offsets[i + 1] += offsets[i];
+        }
+        let mut fill = offsets.clone();
+        let mut entry = vec![0u32; table.nnz()];
+        let mut point = vec![0u32; table.nnz()];
+        for q in 0..table.rows() {
+            for k in table.range(q) {
+                let i = table.index[k] as usize;
+                entry[fill[i]] = k as u32;
+                point[fill[i]] = q as u32;
+                fill[i] += 1;
+            }
+        }
+        Gather { offsets, entry, point }
+    }
+    #[inline]
+    pub fn range(&self, i: usize) -> std::ops::Range<usize> {
+        self.offsets[i]..self.offsets[i + 1]
+    }
+}
+
+/// Everything the time loop works on.
+#[derive(Clone, Debug)]
+pub struct Model {
+    pub mode: GeometryMode,
+    pub particles: Particles,
+    pub quad: QuadraturePoints,
+    /// Material of each body (indexed by body number).
+    pub materials: Vec<Material>,
+    pub bodies: Vec<BodyInfo>,
+    /// `N_I(X_q)`, `∇N_I(X_q)` at the quadrature points.
+    pub qp_shape: ShapeTable,
+    /// `N_J(X_I)` at the particles themselves (physical displacement, output, contact).
+    pub particle_shape: ShapeTable,
+    /// Transpose of `qp_shape`.
+    pub gather: Gather,
+}
+
+/// Errors while building a model.
+#[derive(Debug, thiserror::Error)]
+pub enum ModelError {
+    #[error("body '{body}': {source}")]
+    Shape {
+        body: String,
+        #[source]
+        source: ShapeError,
+    },
+    #[error("body '{body}': {message}")]
+    Invalid { body: String, message: String },
+}
+
+impl Model {
+    /// Generate particles and quadrature points for every body, build the
+    /// shape-function tables, lump the masses and apply initial conditions.
+    pub fn build(mode: GeometryMode, bodies: &[BodySetup]) -> Result<Model, ModelError> {
+        let mut particles = Particles::default();
+        let mut quad = QuadraturePoints::default();
+        let mut infos = Vec::new();
+        let mut qp_rows: Vec<ShapeTable> = Vec::new();
+        let mut p_rows: Vec<ShapeTable> = Vec::new();
+        let mut materials = Vec::new();
+        for (b, setup) in bodies.iter().enumerate() {
+            let mut grid = setup.grid.clone();
+            grid.resolve(mode);
+            let g = grid.generate(mode);
+            let t0 = setup.material.initial_temperature();
+            let p_start = particles.len();
+            for k in 0..g.particles.len() {
+                let x = g.particles[k];
+                let mut flags = ParticleFlags::default();
+                if g.on_boundary[k] {
+                    flags.set(ParticleFlags::SURFACE);
+                }
+                if mode == GeometryMode::Axisymmetric && x.x.abs() < 1e-12 {
+                    flags.set(ParticleFlags::ON_AXIS);
+                }
+                if setup.clamps.iter().any(|r| r.contains(&x)) {
+                    flags.set(ParticleFlags::CLAMPED);
+                }
+                particles.push(x, g.volume[k], g.spacing[k], g.support[k], t0, b as u32, flags);
+            }
+            let p_end = particles.len();
+            let q_start = quad.len();
+            let s0 = PointState::at_rest(t0);
+            for (x, w) in g.quad_points.iter().zip(&g.quad_weights) {
+                quad.push(*x, *w, b as u32, &s0);
+            }
+            let shape_err = |source| ModelError::Shape { body: setup.name.clone(), source };
+            let x0 = &particles.x0[p_start..p_end];
+            let sup = &particles.support[p_start..p_end];
+            let vol = &particles.volume[p_start..p_end];
+            let mut tq = build_table(&g.quad_points, x0, sup, vol, &AllVisible).map_err(shape_err)?;
+            let mut tp = build_table(x0, x0, sup, vol, &AllVisible).map_err(shape_err)?;
+            for i in tq.index.iter_mut().chain(tp.index.iter_mut()) {
+                *i += p_start as u32;
+            }
+            qp_rows.push(tq);
+            p_rows.push(tp);
+            infos.push(BodyInfo {
+                name: setup.name.clone(),
+                particles: p_start..p_end,
+                quad_points: q_start..quad.len(),
+                columns: g.columns,
+                rows: g.rows,
+            });
+            materials.push(setup.material.clone());
+        }
+        let qp_shape = concat_tables(qp_rows);
+        let particle_shape = concat_tables(p_rows);
+        let gather = Gather::new(&qp_shape, particles.len());
+        let mut model = Model { mode, particles, quad, materials, bodies: infos, qp_shape, particle_shape, gather };
+        model.lump_masses();
+        for (b, setup) in bodies.iter().enumerate() {
+            let range = model.bodies[b].particles.clone();
+            for (v, region) in &setup.initial_velocity {
+                for i in range.clone() {
+                    if region.is_none_or(|r| r.contains(&model.particles.x0[i])) {
+                        model.particles.v[i] = *v;
+                    }
+                }
+            }
+            if model.particles.mass[range.clone()].iter().any(|m| *m <= 0.0) {
+                return Err(ModelError::Invalid {
+                    body: setup.name.clone(),
+                    message: "a particle received no mass (its support covers no quadrature point)".into(),
+                });
+            }
+        }
+        model.apply_constraints();
+        Ok(model)
+    }
+
+    /// Row-sum lumped masses `m_I = Σ_q ρ₀ N_I(X_q) w_q` (SPEC §4).
+    pub fn lump_masses(&mut self) {
+        let p = &mut self.particles;
+        for i in 0..p.len() {
+            let mut m = 0.0;
+            for j in self.gather.range(i) {
+                let (k, q) = (self.gather.entry[j] as usize, self.gather.point[j] as usize);
+                let rho = self.materials[self.quad.body[q] as usize].density();
+                m += rho * self.qp_shape.value[k] * self.quad.weight[q];
+            }
+            p.mass[i] = m;
+        }
+    }
+
+    /// Zero the constrained components of `U` and `V`: clamped particles
+    /// entirely, axis particles radially (SPEC §1, §4).
+    pub fn apply_constraints(&mut self) {
+        let p = &mut self.particles;
+        for i in 0..p.len() {
+            let f = p.flags[i];
+            if f.has(ParticleFlags::CLAMPED) {
+                p.u[i] = Vec2::zeros();
+                p.v[i] = Vec2::zeros();
+            } else if f.has(ParticleFlags::ON_AXIS) {
+                p.u[i].x = 0.0;
+                p.v[i].x = 0.0;
+            }
+        }
+    }
+
+    /// Physical displacement at each particle `u(X_I) = Σ_J N_J(X_I) U_J`.
+    pub fn physical(&self, field: &[Vec2]) -> Vec<Vec2> {
+        (0..self.particles.len()).map(|i| self.particle_shape.interpolate(i, field)).collect()
+    }
+
+    /// Lumped projection of a quadrature field onto the particles:
+    /// `f_I = Σ_q N_I(X_q) w_q f_q / Σ_q N_I(X_q) w_q` (the same weights as
+    /// the lumped mass).
+    pub fn project<T>(&self, f: impl Fn(usize) -> T) -> Vec<T>
+    where
+        T: Copy + std::ops::Add<Output = T> + std::ops::Mul<Real, Output = T> + Default,
+    {
+        (0..self.particles.len())
+            .map(|i| {
+                let (mut acc, mut wsum) = (T::default(), 0.0);
+                for j in self.gather.range(i) {
+                    let (k, q) = (self.gather.entry[j] as usize, self.gather.point[j] as usize);
+                    let w = self.qp_shape.value[k] * self.quad.weight[q];
+                    acc = acc + f(q) * w;
+                    wsum += w;
+                }
+                if wsum != 0.0 {
+                    acc * (1.0 / wsum)
+                } else {
+                    acc
+                }
+            })
+            .collect()
+    }
+
+    /// Smallest particle spacing, m.
+    pub fn min_spacing(&self) -> Real {
+        self.particles.spacing.iter().cloned().fold(Real::INFINITY, Real::min)
+    }
+
+    /// Largest longitudinal wave speed of the materials, m/s.
+    pub fn max_wave_speed(&self) -> Real {
+        self.materials.iter().map(|m| m.longitudinal_wave_speed()).fold(0.0, Real::max)
+    }
+}
+
+fn concat_tables(parts: Vec<ShapeTable>) -> ShapeTable {
+    let mut t = ShapeTable { offsets: vec![0], ..Default::default() };
+    for p in parts {
+        let base = t.index.len();
+        t.offsets.extend(p.offsets[1..].iter().map(|o| o + base));
+        t.index.extend(p.index);
+        t.value.extend(p.value);
+        t.grad.extend(p.grad);
+    }
+    t
+}

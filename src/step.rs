@@ -1,0 +1,307 @@
+//! The explicit time loop (SPEC §5): one documented stage order, stage
+//! timers, energy bookkeeping and instability detection.
+
+use crate::material::{Constitutive, StepKinematics};
+use crate::math::{ddot, skew, sym, Real, Tensor3, Vec2};
+use crate::model::Model;
+use crate::particles::ParticleFlags;
+use nalgebra::Matrix2;
+use rayon::prelude::*;
+use std::time::{Duration, Instant};
+
+/// How the time step is chosen (SPEC §5).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TimeStepRule {
+    /// `Δt = safety · min_I h_I / c_L`.
+    Cfl { safety: Real },
+    /// A fixed step, s.
+    Fixed(Real),
+}
+
+/// Energy account, J (per unit depth in plane strain).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Energies {
+    /// `½ Σ m_I |V_I|²` at the last full step.
+    pub kinetic: Real,
+    /// Stress work `∫∫ τ : d dV₀ dt` (elastic energy + plastic dissipation).
+    pub internal: Real,
+    /// Work done on the bodies by external and contact forces.
+    pub external_work: Real,
+    /// Kinetic energy at the start of the run.
+    pub initial_kinetic: Real,
+}
+
+impl Energies {
+    /// `kinetic + internal − external_work`, which stays at its initial value
+    /// in an exact integration.
+    pub fn total(&self) -> Real {
+        self.kinetic + self.internal - self.external_work
+    }
+    /// Relative drift of the balance against the larger of the energy put in
+    /// and the initial kinetic energy.
+    pub fn drift(&self) -> Real {
+        let scale = self.initial_kinetic.max(self.external_work.abs()).max(Real::MIN_POSITIVE);
+        (self.total() - self.initial_kinetic) / scale
+    }
+}
+
+/// Wall time spent in each stage.
+#[derive(Clone, Debug, Default)]
+pub struct StageTimers {
+    pub integration: Duration,
+    pub material: Duration,
+    pub internal_force: Duration,
+    pub diagnostics: Duration,
+}
+
+impl StageTimers {
+    /// `(name, duration)` pairs in stage order.
+    pub fn list(&self) -> Vec<(&'static str, Duration)> {
+        vec![
+            ("time integration", self.integration),
+            ("velocity gradient + material", self.material),
+            ("internal force", self.internal_force),
+            ("diagnostics", self.diagnostics),
+        ]
+    }
+}
+
+/// A run that went wrong, with where and when.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SolverError {
+    #[error(
+        "non-finite {field} at {location} {index} in step {step} (t = {time:.6e} s); \
+         likely cause: time step too large for the particle spacing, or a support too small"
+    )]
+    NonFinite { field: &'static str, location: &'static str, index: usize, step: u64, time: Real },
+    #[error(
+        "deformation gradient inverted (J = {jacobian:.3e}) at quadrature point {point} \
+         (X = ({x:.4e}, {y:.4e}) m) in step {step} (t = {time:.6e} s); likely cause: \
+         time step too large or excessive distortion"
+    )]
+    Inverted { point: usize, x: Real, y: Real, jacobian: Real, step: u64, time: Real },
+    #[error(
+        "particle {particle} moves at {speed:.3e} m/s, above the bound {bound:.3e} m/s, in step {step} \
+         (t = {time:.6e} s); the solution has gone unstable (time step too large?)"
+    )]
+    Runaway { particle: usize, speed: Real, bound: Real, step: u64, time: Real },
+}
+
+/// The running simulation.
+#[derive(Clone, Debug)]
+pub struct Simulation {
+    pub model: Model,
+    /// Simulated time, s.
+    pub time: Real,
+    /// Steps taken.
+    pub step: u64,
+    /// Time step, s.
+    pub dt: Real,
+    pub energies: Energies,
+    pub timers: StageTimers,
+    /// Speed above which a particle is declared runaway, m/s.
+    pub speed_bound: Real,
+    /// Per-point internal-energy increments of the last step (scratch).
+    work_scratch: Vec<Real>,
+}
+
+impl Simulation {
+    /// Start a run at t = 0 with the step chosen by `rule`.
+    pub fn new(model: Model, rule: TimeStepRule) -> Self {
+        let dt = match rule {
+            TimeStepRule::Cfl { safety } => safety * model.min_spacing() / model.max_wave_speed(),
+            TimeStepRule::Fixed(dt) => dt,
+        };
+        let ke = kinetic_energy(&model.particles.mass, &model.particles.v);
+        let vmax = model.particles.v.iter().map(|v| v.norm()).fold(0.0, Real::max);
+        let nq = model.quad.len();
+        Simulation {
+            model,
+            time: 0.0,
+            step: 0,
+            dt,
+            energies: Energies { kinetic: ke, initial_kinetic: ke, ..Default::default() },
+            timers: StageTimers::default(),
+            speed_bound: 10.0 * vmax.max(1000.0),
+            work_scratch: vec![0.0; nq],
+        }
+    }
+
+    /// Advance one step `t → t + Δt`. Stages, in order:
+    /// 1. time integration: `a = (f_ext − f_int)/m`, `V ← V + Δt a`,
+    ///    `U ← U + Δt V`, constraints (SPEC §5);
+    /// 2. velocity gradient and deformation gradient at each quadrature point
+    ///    (`F` at the new step, `ℓ = Ḟ F_mid⁻¹` at mid-step; SPEC §2);
+    /// 3. material update (SPEC §6) and `P w = τ F⁻ᵀ w_q`;
+    /// 4. internal force by gather over particles (SPEC §4);
+    /// 5. diagnostics: energies, non-finite values, runaway speeds.
+    ///
+    /// Contact, heat conduction and crack growth enter between these stages
+    /// as their modules land.
+    pub fn step(&mut self) -> Result<(), SolverError> {
+        let dt = self.dt;
+        let t0 = Instant::now();
+        self.integrate(dt);
+        let t1 = Instant::now();
+        self.update_material(dt)?;
+        let t2 = Instant::now();
+        self.internal_force();
+        let t3 = Instant::now();
+        self.time += dt;
+        self.step += 1;
+        self.diagnose()?;
+        let t4 = Instant::now();
+        self.timers.integration += t1 - t0;
+        self.timers.material += t2 - t1;
+        self.timers.internal_force += t3 - t2;
+        self.timers.diagnostics += t4 - t3;
+        Ok(())
+    }
+
+    /// Central-difference update of velocities and displacements; records the
+    /// kinetic energy at the full step from the mean of the half-step velocities.
+    fn integrate(&mut self, dt: Real) {
+        let p = &mut self.model.particles;
+        let ke: Vec<Real> = (p.v.par_iter_mut(), p.u.par_iter_mut(), p.a.par_iter_mut(), &p.f_int, &p.f_ext, &p.mass, &p.flags)
+            .into_par_iter()
+            .map(|(v, u, a, fi, fe, m, flags)| {
+                let mut acc = (fe - fi) / *m;
+                if flags.has(ParticleFlags::CLAMPED) {
+                    acc = Vec2::zeros();
+                } else if flags.has(ParticleFlags::ON_AXIS) {
+                    acc.x = 0.0;
+                }
+                let v_old = *v;
+                *a = acc;
+                *v += acc * dt;
+                *u += *v * dt;
+                let vm = (v_old + *v) * 0.5;
+                0.5 * m * vm.norm_squared()
+            })
+            .collect();
+        self.energies.kinetic = ke.iter().sum();
+    }
+
+    /// Deformation and velocity gradients, material update, `P w`.
+    #[allow(non_snake_case)]
+    fn update_material(&mut self, dt: Real) -> Result<(), SolverError> {
+        let m = &mut self.model;
+        let (tab, u, v, mode, mats) = (&m.qp_shape, &m.particles.u, &m.particles.v, m.mode, &m.materials);
+        let q = &mut m.quad;
+        let bad = (
+            q.f.par_iter_mut(),
+            q.tau.par_iter_mut(),
+            q.eps_p.par_iter_mut(),
+            q.eps_p_rate.par_iter_mut(),
+            q.temperature.par_iter_mut(),
+            q.damage.par_iter_mut(),
+            q.pw.par_iter_mut(),
+            self.work_scratch.par_iter_mut(),
+            &q.x0,
+            &q.weight,
+            &q.body,
+        )
+            .into_par_iter()
+            .enumerate()
+            .map(|(qi, (f, tau, eps_p, eps_rate, temp, dmg, pw, work, x0, w, body))| {
+                // Legend: gu = grad U, gv = grad V (2x2), uq/vq = interpolated U, V.
+                let mut gu = Matrix2::<Real>::zeros();
+                let mut gv = Matrix2::<Real>::zeros();
+                let (mut uq, mut vq) = (Vec2::zeros(), Vec2::zeros());
+                for k in tab.range(qi) {
+                    let i = tab.index[k] as usize;
+                    let (n, g) = (tab.value[k], tab.grad[k]);
+                    gu += u[i] * g.transpose();
+                    gv += v[i] * g.transpose();
+                    uq += u[i] * n;
+                    vq += v[i] * n;
+                }
+                let F_new = mode.deformation_gradient(&gu, &uq, x0, 1.0);
+                let F_dot = mode.deformation_gradient(&gv, &vq, x0, 0.0);
+                let F_mid = (*f + F_new) * 0.5;
+                let J = F_new.determinant();
+                let Some(F_mid_inv) = F_mid.try_inverse() else {
+                    return Some((qi, J));
+                };
+                let Some(F_inv) = F_new.try_inverse() else {
+                    return Some((qi, J));
+                };
+                if J <= 0.0 || !J.is_finite() {
+                    return Some((qi, J));
+                }
+                let l = F_dot * F_mid_inv;
+                let kin = StepKinematics { d: sym(&l), w: skew(&l), dt };
+                let old = crate::material::PointState {
+                    tau: *tau,
+                    eps_p: *eps_p,
+                    eps_p_rate: *eps_rate,
+                    temperature: *temp,
+                    damage: *dmg,
+                };
+                let new = mats[*body as usize].update(&old, &kin);
+                *work = 0.5 * ddot(&(old.tau + new.tau), &kin.d) * dt * w;
+                *f = F_new;
+                *tau = new.tau;
+                *eps_p = new.eps_p;
+                *eps_rate = new.eps_p_rate;
+                *temp = new.temperature;
+                *dmg = new.damage;
+                *pw = new.tau * F_inv.transpose() * *w;
+                None
+            })
+            .find_first(|r| r.is_some())
+            .flatten();
+        if let Some((point, jacobian)) = bad {
+            let x = self.model.quad.x0[point];
+            return Err(SolverError::Inverted {
+                point,
+                x: x.x,
+                y: x.y,
+                jacobian,
+                step: self.step + 1,
+                time: self.time + dt,
+            });
+        }
+        self.energies.internal += self.work_scratch.iter().sum::<Real>();
+        Ok(())
+    }
+
+    /// `f_int,I = Σ_q (P w)_q ∇N_I(X_q)` (+ hoop term), gathered per particle.
+    fn internal_force(&mut self) {
+        let m = &mut self.model;
+        let (tab, gather, pw, xq, mode) = (&m.qp_shape, &m.gather, &m.quad.pw, &m.quad.x0, m.mode);
+        m.particles.f_int.par_iter_mut().enumerate().for_each(|(i, f)| {
+            let mut acc = Vec2::zeros();
+            for j in gather.range(i) {
+                let (k, q) = (gather.entry[j] as usize, gather.point[j] as usize);
+                acc += mode.internal_force(&pw[q], tab.value[k], &tab.grad[k], &xq[q]);
+            }
+            *f = acc;
+        });
+    }
+
+    /// Catch NaN/Inf and runaway speeds right after the stages that make them.
+    fn diagnose(&self) -> Result<(), SolverError> {
+        let p = &self.model.particles;
+        let (step, time) = (self.step, self.time);
+        if let Some(i) = p.v.par_iter().position_first(|v| !v.x.is_finite() || !v.y.is_finite()) {
+            return Err(SolverError::NonFinite { field: "velocity", location: "particle", index: i, step, time });
+        }
+        if let Some(i) = p.f_int.par_iter().position_first(|f| !f.x.is_finite() || !f.y.is_finite()) {
+            return Err(SolverError::NonFinite { field: "internal force", location: "particle", index: i, step, time });
+        }
+        if let Some(q) = self.model.quad.tau.par_iter().position_first(|t: &Tensor3| !t.iter().all(|x| x.is_finite())) {
+            return Err(SolverError::NonFinite { field: "stress", location: "quadrature point", index: q, step, time });
+        }
+        let bound2 = self.speed_bound * self.speed_bound;
+        if let Some(i) = p.v.par_iter().position_first(|v| v.norm_squared() > bound2) {
+            return Err(SolverError::Runaway { particle: i, speed: p.v[i].norm(), bound: self.speed_bound, step, time });
+        }
+        Ok(())
+    }
+}
+
+/// `½ Σ m |v|²`, summed in index order.
+pub fn kinetic_energy(mass: &[Real], v: &[Vec2]) -> Real {
+    mass.iter().zip(v).map(|(m, v)| 0.5 * m * v.norm_squared()).sum()
+}
