@@ -9,7 +9,7 @@ use crate::discretize::RectangleGrid;
 use crate::geometry::GeometryMode;
 use crate::material::{Elastic, Material, ThermalProperties};
 use crate::math::{Real, Vec2};
-use crate::model::{BodySetup, Region};
+use crate::model::{BodySetup, Region, Support};
 use crate::step::TimeStepRule;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -89,10 +89,10 @@ pub struct BodySpec {
     /// Initial velocities, m/s, applied in order (a later region overrides).
     #[serde(default)]
     pub initial_velocity: Vec<InitialVelocity>,
-    /// Clamped regions: generalized displacements held at zero. Make them at
-    /// least one support width deep (SPEC §4).
+    /// Supports: `{ region = {...}, fix = "all" | "x" | "y" }`. A clamp
+    /// (`fix = "all"`) should be at least one support width deep (SPEC §4).
     #[serde(default)]
-    pub clamps: Vec<Region>,
+    pub supports: Vec<Support>,
 }
 
 /// `[[bodies.initial_velocity]]`
@@ -337,8 +337,8 @@ impl Case {
                     validate_region(&mut add, &format!("{k}.initial_velocity[{j}].region"), r);
                 }
             }
-            for (j, r) in body.clamps.iter().enumerate() {
-                validate_region(&mut add, &format!("{k}.clamps[{j}]"), r);
+            for (j, s) in body.supports.iter().enumerate() {
+                validate_region(&mut add, &format!("{k}.supports[{j}].region"), &s.region);
             }
         }
         for (r, rb) in self.rigid_bodies.iter().enumerate() {
@@ -440,7 +440,7 @@ impl Case {
                     .iter()
                     .map(|iv| (Vec2::new(iv.velocity[0], iv.velocity[1]), iv.region))
                     .collect(),
-                clamps: b.clamps.clone(),
+                supports: b.supports.clone(),
             })
             .collect()
     }

@@ -32,6 +32,34 @@ impl Region {
     }
 }
 
+/// Which displacement components a support holds at zero.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Fix {
+    /// Both components: a clamp.
+    All,
+    /// Only x (r): a roller on a plane of constant x, or a symmetry plane.
+    X,
+    /// Only y (z): a roller on a plane of constant y.
+    Y,
+}
+
+/// A support: the particles in `region` have the `fix` components of their
+/// generalized displacement held at zero (SPEC §4).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Support {
+    /// The particles held.
+    pub region: Region,
+    /// Components held. Default `"all"` (clamped).
+    #[serde(default = "fix_all")]
+    pub fix: Fix,
+}
+
+fn fix_all() -> Fix {
+    Fix::All
+}
+
 /// What the model builder needs for one deformable body.
 #[derive(Clone, Debug)]
 pub struct BodySetup {
@@ -40,8 +68,8 @@ pub struct BodySetup {
     pub material: Material,
     /// Initial velocity and, optionally, the region it applies to (all if `None`).
     pub initial_velocity: Vec<(Vec2, Option<Region>)>,
-    /// Clamped regions.
-    pub clamps: Vec<Region>,
+    /// Supports: regions and the components they hold.
+    pub supports: Vec<Support>,
 }
 
 /// Per-body bookkeeping.
@@ -152,10 +180,14 @@ impl Model {
                     flags.set(ParticleFlags::SURFACE);
                 }
                 if mode == GeometryMode::Axisymmetric && x.x.abs() < 1e-12 {
-                    flags.set(ParticleFlags::ON_AXIS);
+                    flags.set(ParticleFlags::ON_AXIS | ParticleFlags::FIX_X);
                 }
-                if setup.clamps.iter().any(|r| r.contains(&x)) {
-                    flags.set(ParticleFlags::CLAMPED);
+                for s in setup.supports.iter().filter(|s| s.region.contains(&x)) {
+                    match s.fix {
+                        Fix::All => flags.set(ParticleFlags::FIX_X | ParticleFlags::FIX_Y),
+                        Fix::X => flags.set(ParticleFlags::FIX_X),
+                        Fix::Y => flags.set(ParticleFlags::FIX_Y),
+                    }
                 }
                 particles.push(x, g.volume[k], g.spacing[k], g.support[k], t0, b as u32, flags);
             }
@@ -224,19 +256,13 @@ impl Model {
         }
     }
 
-    /// Zero the constrained components of `U` and `V`: clamped particles
-    /// entirely, axis particles radially (SPEC §1, §4).
+    /// Zero the constrained components of `U` and `V`: supports, and the
+    /// radial component on the axis (SPEC §1, §4).
     pub fn apply_constraints(&mut self) {
         let p = &mut self.particles;
         for i in 0..p.len() {
-            let f = p.flags[i];
-            if f.has(ParticleFlags::CLAMPED) {
-                p.u[i] = Vec2::zeros();
-                p.v[i] = Vec2::zeros();
-            } else if f.has(ParticleFlags::ON_AXIS) {
-                p.u[i].x = 0.0;
-                p.v[i].x = 0.0;
-            }
+            constrain(p.flags[i], &mut p.u[i]);
+            constrain(p.flags[i], &mut p.v[i]);
         }
     }
 
@@ -278,6 +304,17 @@ impl Model {
     /// Largest longitudinal wave speed of the materials, m/s.
     pub fn max_wave_speed(&self) -> Real {
         self.materials.iter().map(|m| m.longitudinal_wave_speed()).fold(0.0, Real::max)
+    }
+}
+
+/// Zero the components of `v` that `flags` hold fixed.
+#[inline]
+pub fn constrain(flags: ParticleFlags, v: &mut Vec2) {
+    if flags.has(ParticleFlags::FIX_X) {
+        v.x = 0.0;
+    }
+    if flags.has(ParticleFlags::FIX_Y) {
+        v.y = 0.0;
     }
 }
 

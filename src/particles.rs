@@ -14,14 +14,17 @@ pub struct ParticleFlags(pub u8);
 impl ParticleFlags {
     /// On the outer boundary of its body.
     pub const SURFACE: u8 = 1;
-    /// Generalized displacement held at zero (clamped support), both components.
-    pub const CLAMPED: u8 = 2;
-    /// On the symmetry axis (axisymmetry): radial component held at zero.
-    pub const ON_AXIS: u8 = 4;
+    /// x (radial) component of the generalized displacement held at zero
+    /// (clamp, roller, symmetry plane, or the axis in axisymmetry).
+    pub const FIX_X: u8 = 2;
+    /// y component held at zero.
+    pub const FIX_Y: u8 = 4;
     /// On a crack face.
     pub const CRACK_FACE: u8 = 8;
     /// In the contact slave set.
     pub const SLAVE: u8 = 16;
+    /// On the symmetry axis (axisymmetry).
+    pub const ON_AXIS: u8 = 32;
 
     #[inline]
     pub fn has(self, f: u8) -> bool {

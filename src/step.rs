@@ -3,8 +3,7 @@
 
 use crate::material::{Constitutive, StepKinematics};
 use crate::math::{ddot, skew, sym, Real, Tensor3, Vec2};
-use crate::model::Model;
-use crate::particles::ParticleFlags;
+use crate::model::{constrain, Model};
 use nalgebra::Matrix2;
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -21,7 +20,7 @@ pub enum TimeStepRule {
 /// Energy account, J (per unit depth in plane strain).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Energies {
-    /// `½ Σ m_I |V_I|²` at the last full step.
+    /// `½ Σ m_I |V_I|²` at the last full step (see `full_step_kinetic_energy`).
     pub kinetic: Real,
     /// Stress work `∫∫ τ : d dV₀ dt` (elastic energy + plastic dissipation).
     pub internal: Real,
@@ -150,6 +149,7 @@ impl Simulation {
         self.time += dt;
         self.step += 1;
         self.diagnose()?;
+        self.energies.kinetic = self.full_step_kinetic_energy();
         let t4 = Instant::now();
         self.timers.integration += t1 - t0;
         self.timers.material += t2 - t1;
@@ -158,28 +158,34 @@ impl Simulation {
         Ok(())
     }
 
-    /// Central-difference update of velocities and displacements; records the
-    /// kinetic energy at the full step from the mean of the half-step velocities.
+    /// Central-difference update of velocities and displacements.
     fn integrate(&mut self, dt: Real) {
         let p = &mut self.model.particles;
-        let ke: Vec<Real> = (p.v.par_iter_mut(), p.u.par_iter_mut(), p.a.par_iter_mut(), &p.f_int, &p.f_ext, &p.mass, &p.flags)
+        (p.v.par_iter_mut(), p.u.par_iter_mut(), p.a.par_iter_mut(), &p.f_int, &p.f_ext, &p.mass, &p.flags)
             .into_par_iter()
-            .map(|(v, u, a, fi, fe, m, flags)| {
+            .for_each(|(v, u, a, fi, fe, m, flags)| {
                 let mut acc = (fe - fi) / *m;
-                if flags.has(ParticleFlags::CLAMPED) {
-                    acc = Vec2::zeros();
-                } else if flags.has(ParticleFlags::ON_AXIS) {
-                    acc.x = 0.0;
-                }
-                let v_old = *v;
+                constrain(*flags, &mut acc);
                 *a = acc;
                 *v += acc * dt;
                 *u += *v * dt;
-                let vm = (v_old + *v) * 0.5;
-                0.5 * m * vm.norm_squared()
+            });
+    }
+
+    /// Kinetic energy at the full step `t_{n+1}`, from the full-step velocity
+    /// `V^{n+1} = V^{n+½} + ½ Δt a^{n+1}` (velocity-Verlet form of the central
+    /// difference), so that it is reported at the same instant as the
+    /// internal energy, whose state is `τ^{n+1}`. Summed in index order.
+    fn full_step_kinetic_energy(&self) -> Real {
+        let p = &self.model.particles;
+        let half = 0.5 * self.dt;
+        (0..p.len())
+            .map(|i| {
+                let mut acc = (p.f_ext[i] - p.f_int[i]) / p.mass[i];
+                constrain(p.flags[i], &mut acc);
+                0.5 * p.mass[i] * (p.v[i] + acc * half).norm_squared()
             })
-            .collect();
-        self.energies.kinetic = ke.iter().sum();
+            .sum()
     }
 
     /// Deformation and velocity gradients, material update, `P w`.
