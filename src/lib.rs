@@ -15,3 +15,6 @@ pub mod model;
 pub mod neighbors;
 pub mod step;
 pub mod case;
+pub mod output;
+pub mod run;
+pub mod cases;

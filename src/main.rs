@@ -1,1 +1,211 @@
-fn main(){}
+//! The `plugsim` command line.
+
+use anyhow::{bail, Context, Result};
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+use plugsim::case::Case;
+use plugsim::cases::{builtin_case, BUILTIN_CASES};
+use plugsim::model::Model;
+use plugsim::run::{execute, Progress, RunConfig, RunInfo};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+#[derive(Parser)]
+#[command(name = "plugsim", version = concat!(env!("CARGO_PKG_VERSION"), " (", env!("PLUGSIM_COMMIT"), ")"),
+          about = "Meshfree (RKPM) simulation of high-speed impact, plugging and ductile fracture")]
+struct Cli {
+    /// Worker threads (default: all cores).
+    #[arg(long, global = true)]
+    threads: Option<usize>,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a case file (or a built-in case with --case).
+    Run {
+        /// Case file (TOML).
+        case_file: Option<PathBuf>,
+        /// A built-in case by name (see `plugsim cases`).
+        #[arg(long, conflicts_with = "case_file")]
+        case: Option<String>,
+        /// Output directory (default: the case's output.directory, else runs/<case name>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Override a case value, e.g. --set time.end=2e-5 (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Write into an existing non-empty output directory.
+        #[arg(long)]
+        force: bool,
+    },
+    /// Check a case file without running it: validation, particle counts, time step.
+    Check {
+        case_file: Option<PathBuf>,
+        #[arg(long, conflicts_with = "case_file")]
+        case: Option<String>,
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+    },
+    /// List the built-in cases.
+    Cases,
+}
+
+/// Load a case from a file or the built-in set; returns the case and a name for it.
+fn load(case_file: &Option<PathBuf>, builtin: &Option<String>, set: &[String]) -> Result<(Case, String, String)> {
+    match (case_file, builtin) {
+        (Some(path), None) => {
+            let case = Case::load(path, set)?;
+            let stem = path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_else(|| "case".into());
+            Ok((case, stem, path.display().to_string()))
+        }
+        (None, Some(name)) => {
+            let Some(text) = builtin_case(name) else {
+                bail!("unknown built-in case '{name}'; available: {}", BUILTIN_CASES.iter().map(|c| c.0).collect::<Vec<_>>().join(", "))
+            };
+            let file = format!("<built-in {name}>");
+            let case = Case::from_str_with(text, &file, set)?;
+            Ok((case, name.clone(), file))
+        }
+        _ => bail!("give a case file or --case NAME (see `plugsim cases`)"),
+    }
+}
+
+fn main() {
+    let cli = Cli::parse();
+    if let Some(n) = cli.threads {
+        if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n).build_global() {
+            eprintln!("error: cannot set up {n} threads: {e}");
+            std::process::exit(2);
+        }
+    }
+    let code = match dispatch(cli.command) {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            1
+        }
+    };
+    std::process::exit(code);
+}
+
+fn dispatch(cmd: Command) -> Result<()> {
+    match cmd {
+        Command::Cases => {
+            for (name, _, about) in BUILTIN_CASES {
+                println!("{name:28} {about}");
+            }
+            Ok(())
+        }
+        Command::Check { case_file, case, set } => {
+            let (case, _, file) = load(&case_file, &case, &set)?;
+            check(&case, &file)
+        }
+        Command::Run { case_file, case, out, set, force } => {
+            let (case, name, file) = load(&case_file, &case, &set)?;
+            let out_dir = out
+                .or_else(|| case.output.directory.as_ref().map(PathBuf::from))
+                .unwrap_or_else(|| Path::new("runs").join(&name));
+            run(&case, &file, &set, out_dir, force)
+        }
+    }
+}
+
+fn check(case: &Case, file: &str) -> Result<()> {
+    let resolved = case.resolved();
+    let t = Instant::now();
+    let model = Model::build(resolved.geometry.mode, &resolved.body_setups()).context("building the discretization")?;
+    let sim = plugsim::step::Simulation::new(model, resolved.time_step_rule());
+    println!("{file}: OK ({})", if case.title.is_empty() { "untitled" } else { &case.title });
+    println!("  geometry        {:?}", resolved.geometry.mode);
+    for b in &sim.model.bodies {
+        println!(
+            "  body {:10} {} particles ({} x {}), {} quadrature points",
+            b.name,
+            b.particles.len(),
+            b.columns,
+            b.rows,
+            b.quad_points.len()
+        );
+    }
+    println!("  rigid bodies    {}", resolved.rigid_bodies.len());
+    println!("  time step       {:.3e} s ({} steps to {:.3e} s)", sim.dt, (resolved.time.end / sim.dt).ceil(), resolved.time.end);
+    println!("  mass            {:.6e} kg", sim.model.particles.total_mass());
+    println!("  built in        {:.2} s", t.elapsed().as_secs_f64());
+    Ok(())
+}
+
+fn run(case: &Case, file: &str, set: &[String], out_dir: PathBuf, force: bool) -> Result<()> {
+    let cfg = RunConfig { out_dir: out_dir.clone(), force, info: RunInfo::current(file, set) };
+    let tty = std::io::stderr().is_terminal();
+    let bar = ProgressBar::hidden();
+    let started = Instant::now();
+    let end = case.time.end;
+    let mut last_line = 0u64;
+    let mut report = |p: Progress| match p {
+        Progress::Started { sim, steps_estimate } => {
+            eprintln!(
+                "plugsim: {} particles, {} quadrature points, dt = {:.3e} s, {} steps, {} threads -> {}",
+                sim.model.particles.len(),
+                sim.model.quad.len(),
+                sim.dt,
+                steps_estimate,
+                rayon::current_num_threads(),
+                out_dir.display()
+            );
+            if tty {
+                bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+                bar.set_length(steps_estimate);
+                bar.set_style(
+                    ProgressStyle::with_template("{bar:40.cyan/blue} {percent:>3}% {msg} | {per_sec} | ETA {eta}")
+                        .expect("valid template")
+                        .progress_chars("=> "),
+                );
+            }
+        }
+        Progress::Step { sim } => {
+            let msg = format!("t = {:.3} us / {:.3} us, step {}", sim.time * 1e6, end * 1e6, sim.step);
+            if tty {
+                bar.set_position(sim.step);
+                bar.set_message(msg);
+            } else {
+                let pct = (100.0 * sim.time / end) as u64;
+                if pct >= last_line + 10 {
+                    last_line = pct - pct % 10;
+                    let rate = sim.step as f64 / started.elapsed().as_secs_f64();
+                    eprintln!("  {pct:3}%  {msg}  ({rate:.0} steps/s)");
+                }
+            }
+        }
+    };
+    let result = execute(case, &cfg, &mut report);
+    bar.finish_and_clear();
+    let s = result?;
+    let total = s.setup_wall + s.loop_wall + s.output_wall;
+    println!("plugsim run finished: {} steps to t = {:.4e} s (dt = {:.3e} s)", s.steps, s.time, s.dt);
+    println!("  particles / quadrature points  {} / {}", s.particles, s.quadrature_points);
+    println!(
+        "  energy: kinetic {:.4e} J, internal {:.4e} J, external work {:.4e} J, drift {:+.3} % (max {:.3} %)",
+        s.energies.kinetic,
+        s.energies.internal,
+        s.energies.external_work,
+        100.0 * s.energies.drift(),
+        100.0 * s.max_drift
+    );
+    if s.max_drift > 0.05 {
+        println!("  WARNING: the energy balance drifted by more than 5 % of the input energy");
+    }
+    println!("  wall time {:.2} s: setup {:.2} s, time loop {:.2} s, output {:.2} s", total.as_secs_f64(), s.setup_wall.as_secs_f64(), s.loop_wall.as_secs_f64(), s.output_wall.as_secs_f64());
+    for (name, d) in &s.stage_timers {
+        println!("    {name:30} {:8.3} s", d.as_secs_f64());
+    }
+    let qp_rate = s.quadrature_points as f64 * s.steps as f64 / s.loop_wall.as_secs_f64().max(1e-9);
+    println!("  throughput {:.3e} quadrature-point updates/s, {:.1} steps/s", qp_rate, s.steps as f64 / s.loop_wall.as_secs_f64().max(1e-9));
+    println!("  output: {} snapshots in {}/results.pvd, history in history.csv", s.snapshots, s.out_dir.display());
+    for p in &s.plots {
+        println!("  plot: {}", p.display());
+    }
+    Ok(())
+}

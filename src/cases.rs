@@ -1,0 +1,21 @@
+//! Built-in cases, selectable by name from the CLI (`plugsim run --case NAME`).
+//! Each is the text of a file under `cases/`, so what runs is what users read.
+
+/// `(name, case text, one-line description)`.
+pub const BUILTIN_CASES: &[(&str, &str, &str)] = &[
+    (
+        "elastic-strike",
+        include_str!("../cases/elastic-strike.toml"),
+        "elastic steel plate, struck centre patch, plane strain (seconds)",
+    ),
+    (
+        "elastic-disc-axisym",
+        include_str!("../cases/elastic-disc-axisym.toml"),
+        "elastic steel disc, struck centre, axisymmetric (seconds)",
+    ),
+];
+
+/// The text of the built-in case `name`.
+pub fn builtin_case(name: &str) -> Option<&'static str> {
+    BUILTIN_CASES.iter().find(|c| c.0 == name).map(|c| c.1)
+}

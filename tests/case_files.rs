@@ -1,0 +1,119 @@
+//! Case files: the shipped cases parse and validate; bad input is rejected
+//! before the run with a message naming the key and the file.
+
+use plugsim::case::{Case, CaseError};
+use plugsim::cases::BUILTIN_CASES;
+
+const GOOD: &str = include_str!("../cases/elastic-strike.toml");
+
+fn err_of(text: &str) -> String {
+    match Case::from_str_with(text, "bad.toml", &[]) {
+        Ok(_) => panic!("case should have been rejected:\n{text}"),
+        Err(e) => {
+            let s = e.to_string();
+            assert!(s.starts_with("bad.toml"), "message must name the file: {s}");
+            s
+        }
+    }
+}
+
+fn with(from: &str, to: &str) -> String {
+    assert!(GOOD.contains(from), "fixture lacks {from}");
+    GOOD.replacen(from, to, 1)
+}
+
+#[test]
+fn every_builtin_case_parses_and_validates() {
+    for (name, text, _) in BUILTIN_CASES {
+        let case = Case::from_str_with(text, name, &[]).unwrap_or_else(|e| panic!("{e}"));
+        // the resolved case round-trips through TOML
+        let again: Case = toml::from_str(&case.resolved_toml()).unwrap();
+        assert_eq!(again, case.resolved(), "{name}");
+    }
+}
+
+#[test]
+fn unknown_key_is_named() {
+    let s = err_of(&with("poisson_ratio = 0.3", "poisson_ratio = 0.3\npoisons_ratio = 0.3"));
+    assert!(s.contains("poisons_ratio"), "{s}");
+}
+
+#[test]
+fn missing_key_is_named() {
+    let s = err_of(&with("youngs_modulus = 200.0e9  # Pa\n", ""));
+    assert!(s.contains("youngs_modulus"), "{s}");
+}
+
+#[test]
+fn wrong_type_is_named() {
+    let s = err_of(&with("layers = 12", "layers = \"twelve\""));
+    assert!(s.contains("layers") || s.contains("twelve"), "{s}");
+}
+
+#[test]
+fn negative_density_rejected() {
+    let s = err_of(&with("density = 7850.0", "density = -7850.0"));
+    assert!(s.contains("materials.steel.density"), "{s}");
+}
+
+#[test]
+fn incompressible_poisson_rejected() {
+    let s = err_of(&with("poisson_ratio = 0.3", "poisson_ratio = 0.5"));
+    assert!(s.contains("materials.steel.poisson_ratio"), "{s}");
+}
+
+#[test]
+fn zero_thickness_rejected() {
+    let s = err_of(&with("y_max = 0.0111\n", "y_max = 0.0\n"));
+    assert!(s.contains("bodies[0].rectangle.y_max") && s.contains("thickness"), "{s}");
+}
+
+#[test]
+fn non_positive_end_time_rejected() {
+    let s = err_of(&with("end = 30.0e-6", "end = 0.0"));
+    assert!(s.contains("time.end"), "{s}");
+    let s = err_of(&with("end = 30.0e-6", "end = -1.0"));
+    assert!(s.contains("time.end"), "{s}");
+}
+
+#[test]
+fn unknown_material_rejected() {
+    let s = err_of(&with("material = \"steel\"", "material = \"unobtainium\""));
+    assert!(s.contains("bodies[0].material") && s.contains("unobtainium"), "{s}");
+}
+
+#[test]
+fn all_problems_reported_at_once() {
+    let t = with("density = 7850.0", "density = -1.0").replace("end = 30.0e-6", "end = -1.0");
+    let e = Case::from_str_with(&t, "bad.toml", &[]).unwrap_err();
+    let CaseError::Invalid { problems, .. } = e else { panic!("expected Invalid") };
+    let keys: Vec<&str> = problems.iter().map(|p| p.key.as_str()).collect();
+    assert!(keys.contains(&"materials.steel.density") && keys.contains(&"time.end"), "{keys:?}");
+}
+
+#[test]
+fn malformed_toml_rejected() {
+    let s = err_of("[geometry\nmode = ");
+    assert!(s.to_lowercase().contains("line") || s.contains("expected"), "{s}");
+}
+
+#[test]
+fn overrides_apply_and_are_validated() {
+    let c = Case::from_str_with(GOOD, "good.toml", &["time.end=2e-5".into(), "bodies.plate.rectangle.layers=8".into()]).unwrap();
+    assert_eq!(c.time.end, 2e-5);
+    assert_eq!(c.bodies[0].rectangle.layers, 8);
+    let c = Case::from_str_with(GOOD, "good.toml", &["bodies.0.material=steel".into()]).unwrap();
+    assert_eq!(c.bodies[0].material, "steel");
+    let e = Case::from_str_with(GOOD, "good.toml", &["time.end=-3".into()]).unwrap_err().to_string();
+    assert!(e.contains("time.end"), "{e}");
+    let e = Case::from_str_with(GOOD, "good.toml", &["bodies.nosuch.layers=3".into()]).unwrap_err().to_string();
+    assert!(e.contains("nosuch"), "{e}");
+    let e = Case::from_str_with(GOOD, "good.toml", &["time.ned=1".into()]).unwrap_err().to_string();
+    assert!(e.contains("ned"), "{e}");
+}
+
+#[test]
+fn missing_file_is_a_clear_error() {
+    let e = Case::load(std::path::Path::new("/nonexistent/case.toml"), &[]).unwrap_err().to_string();
+    assert!(e.contains("/nonexistent/case.toml") && e.contains("cannot read"), "{e}");
+}
