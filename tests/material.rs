@@ -229,6 +229,20 @@ fn power_law_simple_shear_at_1e4_matches_reference_ode() {
     assert_within(worst, 0.01, "power law, simple shear 1e4/s");
 }
 
+/// Observed order: the damage of the tangent update is first order in the
+/// step (SPEC §6 takes the triaxiality at the start of the step, and in
+/// uniaxial strain it grows steadily), so its error halves with the step.
+#[test]
+fn damage_error_halves_with_the_step() {
+    let error =
+        |steps| driver_vs_reference(&weldox_460e(), LoadPath::UniaxialStrain, 1e4, 0.2, steps)[3];
+    let errors = [error(1000), error(2000), error(4000)];
+    for pair in errors.windows(2) {
+        let order = (pair[0] / pair[1]).log2();
+        assert!((order - 1.0).abs() < 0.1, "order {order} ({errors:?})");
+    }
+}
+
 // ---------------------------------------------------------------------------
 // Rate law, thermal softening, heating, damage.
 // ---------------------------------------------------------------------------

@@ -517,6 +517,23 @@ mod tests {
     }
 
     #[test]
+    fn non_finite_state_is_reported_with_its_step() {
+        let broken = Material::Elastic(Elastic {
+            youngs_modulus: Real::INFINITY,
+            ..match steel() {
+                Material::Elastic(e) => e,
+                _ => unreachable!(),
+            }
+        });
+        match run(&broken, &config(LoadPath::SimpleShear, 1.0, 0.01, 1e-3)) {
+            Err(DriverError::NonFinite { step, field, .. }) => {
+                assert_eq!((step, field), (1, "stress"))
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
     fn uniaxial_stress_keeps_lateral_stress_zero_and_gives_youngs_modulus() {
         let r = run(&steel(), &config(LoadPath::UniaxialStress, 1.0, 1e-3, 1e-5)).unwrap();
         let last = r.last().unwrap();

@@ -10,7 +10,7 @@
 //!
 //! Stress is Kirchhoff `τ = J σ` throughout (SPEC §2); `τ̄ = sqrt(3/2 s:s)`.
 //!
-//! Equation numbers: SPEC §6 restates [RL10] Eqs. (2.46)–(2.72) and names
+//! Equation numbers: SPEC §6 restates \[RL10\] Eqs. (2.46)–(2.72) and names
 //! (2.70) (the tangent modulus `H`) and (2.72) (the objective stress rate)
 //! explicitly; the functions below cite the block where the individual
 //! number is not given in SPEC.
@@ -41,24 +41,24 @@
 //!    (`ε̄̇ = sqrt(2/3 d′:d′)`), and neither temperature nor damage change
 //!    (no plastic work is done at zero stress; `σ*` is undefined at `τ̄ = 0`).
 //!    Tests: `melted_point_has_no_deviatoric_strength`,
-//!    `tests/material.rs::adiabatic_runaway_runs_through_melting`.
+//!    `tests/material.rs::melted_point_flows_like_a_fluid_through_the_driver`.
 //! 5. **Exponent cap and overstress fallback.** The rate-law exponent
 //!    (`(τ̄/g − 1)/C`, or `ln(τ̄/g)/C` for the power law) is capped at
 //!    [`MAX_RATE_EXPONENT`] = 50, i.e. rates above `ε̇₀ e⁵⁰` (≥ 2.6·10¹⁸ s⁻¹
 //!    for any `ε̇₀` in use) are treated as instantaneous; `∂ε̄̇/∂τ̄` is that of
 //!    the law at the capped rate, so the tangent update keeps its implicit
 //!    damping. If the tangent update would still end the step above the
-//!    range the capped law represents, `τ̄ > τ̄_cap = g(1 + 50C)`
-//!    (`g e^{50C}` for the power law) — a huge overstress after a sudden loss
-//!    of strength, or a step whose elastic increment dwarfs a vanishing
-//!    near-melt `g` (the start-of-step flow direction is then wrong and the
-//!    tangent update oscillates) — the step is redone as a backward-Euler
-//!    radial return of the elastic predictor onto the rate law
-//!    (`τ̄ = g·R(Δε̄/Δt)` with `g` at the end-of-step `ε̄`, temperature and
-//!    damage frozen, solved by bisection). Its heating uses the mean of the start and end `τ̄`, the
-//!    elastic energy the return releases (the start-of-step `τ̄` would count
-//!    up to twice that). Tests: `huge_overstress_is_finite_and_relaxes_monotonically`,
-//!    `tests/material.rs::adiabatic_softening_runs_up_to_melting`.
+//!    range the capped law represents, `τ̄ > τ̄_cap = g(1 + 50C)` (`g e^{50C}`
+//!    for the power law) — a huge overstress after a sudden loss of strength,
+//!    which the linearised update would relax only by `~2Cg` per step — the
+//!    step is redone as a backward-Euler radial return of the elastic
+//!    predictor onto the rate law (`τ̄ = g·R(Δε̄/Δt)` with `g` at the
+//!    end-of-step `ε̄`, temperature and damage frozen, solved by bisection;
+//!    damage with the end-of-step triaxiality). Its heating uses the mean of
+//!    the start and end `τ̄`, the elastic energy the return releases (the
+//!    start-of-step `τ̄` would count up to twice that). Tests:
+//!    `huge_overstress_is_finite_and_relaxes_monotonically`,
+//!    `radial_return_from_rest_accumulates_ordinary_damage`.
 //! 6. **`H ≤ 0`** (adiabatic softening beyond the elastic stiffness, a
 //!    snap-back): `ξ` is formed with `max(H, 0)`, so the softening part of the
 //!    linearisation is explicit and `1 + ξ ≥ 1`. The update is written in the
@@ -96,10 +96,12 @@
 //!     direction is not resolved: a linear analysis of the update gives a
 //!     direction error amplified by `1 − 3GΔt ε̇/τ̄` per step, an oscillation
 //!     once the ratio passes 1 and an instability past 2. This happens in
-//!     shear bands at ≳ 10⁷ s⁻¹ with [RL10]'s `Δt = 4·10⁻⁹ s`, and near
+//!     shear bands at ≳ 10⁷ s⁻¹ with \[RL10\]'s `Δt = 4·10⁻⁹ s`, and near
 //!     melting at any rate. Such a step is the backward-Euler radial return
 //!     of Deviation 5, which flows along the elastic predictor and is stable
-//!     for any step. Tests: `tests/material.rs::simple_shear_at_1e7_with_the_paper_step_is_smooth`,
+//!     for any step. In resolved steps (`3GΔt ε̇ ≪ τ̄`) it is never used
+//!     except on the first step from rest. Tests:
+//!     `tests/material.rs::simple_shear_at_1e7_with_the_paper_step_is_smooth`,
 //!     `tests/material.rs::adiabatic_softening_runs_up_to_melting`.
 //!
 //! The damage factor `(1 − D)` (when `damage_coupling` is on) is clamped to
@@ -136,7 +138,7 @@ pub const MIN_FAILURE_STRAIN: Real = 1e-6;
 /// Which strain-rate law multiplies the flow stress (SPEC §6, "Two rate laws").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RateForm {
-    /// Classic Johnson–Cook, `τ̄ = g (1 + C ln(ε̄̇/ε̇₀))`, the form of [RL10]
+    /// Classic Johnson–Cook, `τ̄ = g (1 + C ln(ε̄̇/ε̇₀))`, the form of \[RL10\]
     /// (with `ε̇₀ = 1 s⁻¹`). Flows (vanishingly slowly) at any stress.
     Log,
     /// Børvik's modified law `τ̄ = g (1 + ε̄̇/ε̇₀)^C` (Børvik used
@@ -199,7 +201,7 @@ pub struct JohnsonCook {
     /// Johnson–Cook damage constants.
     pub damage: DamageConstants,
     /// Scale the flow stress by `(1 − D)` (Børvik's coupled model). Default
-    /// off, as in [RL10], where cracks, not softening, carry the failure.
+    /// off, as in \[RL10\], where cracks, not softening, carry the failure.
     pub damage_coupling: bool,
     /// Tangent-method parameter `θ` in [0, 1]; see [`JohnsonCook::DEFAULT_THETA`].
     pub theta: Real,
@@ -520,7 +522,14 @@ impl JohnsonCook {
             RateForm::Power => (1.0 + rate_star).powf(dc.d4),
         };
         let t_star = self.homologous_temperature(temperature).clamp(0.0, 1.0);
-        (stress_term * rate_term * (1.0 + dc.d5 * t_star)).max(MIN_FAILURE_STRAIN)
+        let eps_f = stress_term * rate_term * (1.0 + dc.d5 * t_star);
+        // `max` would turn a NaN input into the floor, i.e. a silent failure;
+        // let it propagate to the solver's NaN check instead.
+        if eps_f.is_nan() {
+            eps_f
+        } else {
+            eps_f.max(MIN_FAILURE_STRAIN)
+        }
     }
 
     /// Elastic part of the objective rate, `C : d = K tr(d) I + 2G d′`.
@@ -686,8 +695,9 @@ impl JohnsonCook {
     /// temperature and damage frozen at the start of the step; the left side
     /// falls and the right rises with `τ̄_e`, so the root is unique and
     /// bisection finds it), scale the predictor's deviator by
-    /// `τ̄_e/τ̄_tr`, heat by `χ (τ̄ + τ̄_e)/2 Δε̄/(ρ₀C_p)` and take the thermal
-    /// pressure `3Kα ΔT` off the mean stress. SPEC §6 (flow rule, heating,
+    /// `τ̄_e/τ̄_tr`, heat by `χ (τ̄ + τ̄_e)/2 Δε̄/(ρ₀C_p)`, take the thermal
+    /// pressure `3Kα ΔT` off the mean stress, and accumulate damage with the
+    /// end-of-step triaxiality. SPEC §6 (flow rule, heating,
     /// damage), [RL10, Eqs. (2.46)–(2.72)].
     fn radial_return(
         &self,
@@ -734,7 +744,9 @@ impl JohnsonCook {
         let mean =
             mean_stress(&trial) - 3.0 * self.bulk_modulus() * self.thermal_expansion * d_temp;
         let rate = d_eps / dt;
-        let triaxiality = mean_stress(&old.tau) / tau_bar;
+        // End-of-step triaxiality, as befits backward Euler (and defined even
+        // from a zero deviator, where the start-of-step one is 0/0).
+        let triaxiality = mean / tau_end;
         PointState {
             tau: s_trial * (tau_end / tau_trial) + identity() * mean,
             eps_p: old.eps_p + d_eps,
@@ -1135,6 +1147,22 @@ mod tests {
                 assert!(ddot(&deviator(&new.tau), &n_hat) >= -1e-9 * tb, "dt {dt}");
             }
         }
+        // (b) at a resolved step is the tangent update with ξ = 0, i.e.
+        // ε̄̇_θ = ε̄̇ + θΔt f_τ P:d (Deviation 6), not a division by 1 + ξ < 1.
+        let dt = 1e-7;
+        let tb = 1.01 * fs_b.g;
+        let new = soft.update(
+            &state(uniaxial(tb), 0.3, t_b),
+            &kin(diag(1e3, 0.0, 0.0), Tensor3::zeros(), dt),
+        );
+        let pr = soft.plastic_rate(tb, fs_b.g);
+        let p_d = 2.0 * soft.shear_modulus() * 1e3; // P:d for uniaxial n̂ and d
+        let want = pr.rate + 0.5 * dt * pr.d_rate_d_tau * p_d;
+        assert!(
+            rel(new.eps_p_rate, want) < 1e-12,
+            "{} vs {want}",
+            new.eps_p_rate
+        );
     }
 
     #[test]
@@ -1170,6 +1198,25 @@ mod tests {
         let p = m.update(&rest, &kin(identity() * 1e3, Tensor3::zeros(), 1e-7));
         assert_eq!(p.eps_p, 0.0);
         assert_eq!(p.tau, identity() * (m.bulk_modulus() * 3e3 * 1e-7));
+    }
+
+    /// Regression: the radial return from a zero deviator took the
+    /// start-of-step triaxiality 0/0 = NaN, which the failure-strain floor
+    /// turned into ε_f = 1e-6, i.e. D ≈ 300 after the first step.
+    #[test]
+    fn radial_return_from_rest_accumulates_ordinary_damage() {
+        let m = weldox_460e();
+        let mut l = Tensor3::zeros();
+        l[(0, 1)] = 1e5;
+        let k = kin(crate::math::sym(&l), crate::math::skew(&l), 1e-7);
+        // Δγ = 1e-2, well beyond the yield strain: the step flows.
+        assert!(m.elastic_increment(&k.d, k.dt) > m.yield_stress);
+        let new = m.update(&PointState::at_rest(293.0), &k);
+        assert!(new.eps_p > 1e-4);
+        let triaxiality = mean_stress(&new.tau) / von_mises(&new.tau);
+        let want = new.eps_p / m.failure_strain(triaxiality, new.eps_p_rate, 293.0);
+        assert!(rel(new.damage, want) < 1e-12, "{} vs {want}", new.damage);
+        assert!(m.failure_strain(Real::NAN, 1.0, 293.0).is_nan());
     }
 
     #[test]

@@ -19,15 +19,15 @@ pub fn builtin(name: &str) -> Option<Material> {
     }
 }
 
-/// Weldox 460 E as [RL10] models it: classic (log) Johnson–Cook rate law
+/// Weldox 460 E as \[RL10\] models it: classic (log) Johnson–Cook rate law
 /// with `ε̇₀ = 1 s⁻¹`.
 ///
-/// Source: [RL10] Table 2 (E, ν, ρ, A, B, n, m, C_p, α, χ, D₁–D₅,
+/// Source: \[RL10\] Table 2 (E, ν, ρ, A, B, n, m, C_p, α, χ, D₁–D₅,
 /// `ε̇₀ = 1`). Not printed there and taken from Børvik et al.'s Weldox 460 E
-/// set: `C = 0.0114`, `T_m = 1800 K`, `T₀ = 293 K`. Conductivity: [RL10]'s
+/// set: `C = 0.0114`, `T_m = 1800 K`, `T₀ = 293 K`. Conductivity: \[RL10\]'s
 /// Table 2 prints "452 J/(kg K)" in that row (a typo, it is `C_p`); a typical
 /// structural-steel value, 50 W/(m K), is used (SPEC §7). Damage coupling off
-/// and `θ = 0.5`, as in [RL10].
+/// and `θ = 0.5`, as in \[RL10\].
 pub fn weldox_460e() -> JohnsonCook {
     JohnsonCook {
         density: 7850.0,
@@ -64,7 +64,7 @@ pub fn weldox_460e() -> JohnsonCook {
 ///
 /// Source: the `[material.weldox_460e.borvik_modified]` table of the
 /// reference file (Børvik et al.'s fit of this steel, quoted alongside
-/// [RL10] Table 2). Børvik's coupled damage model would also scale the flow
+/// \[RL10\] Table 2). Børvik's coupled damage model would also scale the flow
 /// stress by `(1 − D)` and fracture at `D = 0.3`; this set keeps
 /// `damage_coupling` off, so that comparing it with [`weldox_460e`] isolates
 /// the rate law (SPEC §6: "the validation report shows both"). Switch it on
