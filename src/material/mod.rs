@@ -5,9 +5,13 @@
 //! solver only ever sees [`Material`], an enum over the models, so that case
 //! files stay serializable and the hot loop stays monomorphic.
 
+pub mod driver;
 pub mod elastic;
+pub mod johnson_cook;
+pub mod library;
 
 pub use elastic::Elastic;
+pub use johnson_cook::JohnsonCook;
 
 use crate::math::{Real, Tensor3};
 
@@ -83,6 +87,8 @@ pub trait Constitutive {
 pub enum Material {
     /// Hypoelastic, Jaumann rate.
     Elastic(Elastic),
+    /// Johnson–Cook thermo-viscoplasticity with Johnson–Cook damage.
+    JohnsonCook(JohnsonCook),
 }
 
 impl Constitutive for Material {
@@ -90,31 +96,37 @@ impl Constitutive for Material {
     fn update(&self, old: &PointState, k: &StepKinematics) -> PointState {
         match self {
             Material::Elastic(m) => m.update(old, k),
+            Material::JohnsonCook(m) => m.update(old, k),
         }
     }
     fn density(&self) -> Real {
         match self {
             Material::Elastic(m) => m.density(),
+            Material::JohnsonCook(m) => m.density(),
         }
     }
     fn bulk_modulus(&self) -> Real {
         match self {
             Material::Elastic(m) => m.bulk_modulus(),
+            Material::JohnsonCook(m) => m.bulk_modulus(),
         }
     }
     fn shear_modulus(&self) -> Real {
         match self {
             Material::Elastic(m) => m.shear_modulus(),
+            Material::JohnsonCook(m) => m.shear_modulus(),
         }
     }
     fn initial_temperature(&self) -> Real {
         match self {
             Material::Elastic(m) => m.initial_temperature(),
+            Material::JohnsonCook(m) => m.initial_temperature(),
         }
     }
     fn thermal(&self) -> Option<ThermalProperties> {
         match self {
             Material::Elastic(m) => m.thermal(),
+            Material::JohnsonCook(m) => m.thermal(),
         }
     }
 }
