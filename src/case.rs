@@ -7,7 +7,7 @@
 
 use crate::discretize::RectangleGrid;
 use crate::geometry::GeometryMode;
-use crate::material::{Elastic, Material, ThermalProperties};
+use crate::material::{Elastic, JohnsonCook, Material, ThermalProperties};
 use crate::math::{Real, Vec2};
 use crate::model::{BodySetup, Region, Support};
 use crate::step::TimeStepRule;
@@ -70,6 +70,15 @@ pub enum MaterialSpec {
         #[serde(default)]
         thermal_conductivity: Option<Real>,
     },
+    /// Johnson–Cook thermo-viscoplasticity with damage (SPEC §6). Keys are
+    /// the fields of [`JohnsonCook`], units in its documentation: `density`,
+    /// `youngs_modulus`, `poisson_ratio`, `yield_stress` (A), `hardening_modulus`
+    /// (B), `hardening_exponent` (n), `rate_sensitivity` (C),
+    /// `softening_exponent` (m), `melting_temperature`, `room_temperature`,
+    /// `reference_strain_rate`, `rate_form` ("log" | "power"), `specific_heat`,
+    /// `taylor_quinney`, `thermal_expansion`, `conductivity`,
+    /// `damage = { d1, d2, d3, d4, d5 }`, `damage_coupling`, `theta`.
+    JohnsonCook(JohnsonCook),
 }
 
 fn room_temperature() -> Real {
@@ -308,6 +317,13 @@ impl Case {
                         non_negative(&mut add, &format!("{k}.thermal_conductivity"), *c, "W/(m K)");
                     }
                 }
+                MaterialSpec::JohnsonCook(jc) => {
+                    if let Err(errors) = jc.validate() {
+                        for e in errors {
+                            add(format!("{k}.{}", e.parameter), format!("must be {}, got {}", e.requirement, e.value));
+                        }
+                    }
+                }
             }
         }
         if self.bodies.is_empty() {
@@ -467,6 +483,7 @@ impl MaterialSpec {
                     _ => None,
                 },
             }),
+            MaterialSpec::JohnsonCook(jc) => Material::JohnsonCook(jc.clone()),
         }
     }
 }

@@ -18,3 +18,4 @@ pub mod case;
 pub mod output;
 pub mod run;
 pub mod cases;
+pub mod material_point;

@@ -51,6 +51,38 @@ enum Command {
     },
     /// List the built-in cases.
     Cases,
+    /// Drive one material point through a deformation history and write
+    /// stress-strain-temperature-damage curves (CSV + PNG): the calibration tool.
+    MaterialPoint {
+        /// A built-in material name, or NAME from --case-file's [materials].
+        #[arg(long, default_value = "weldox_460e")]
+        material: String,
+        /// Take the material from this case file's [materials] table.
+        #[arg(long)]
+        case_file: Option<PathBuf>,
+        /// Deformation path.
+        #[arg(long, value_enum, default_value = "simple-shear")]
+        path: PathArg,
+        /// Strain rate magnitude, 1/s.
+        #[arg(long, default_value_t = 1.0e4)]
+        rate: f64,
+        /// Final strain (shear strain gamma for simple shear); its sign sets the direction.
+        #[arg(long, default_value_t = 1.0)]
+        strain: f64,
+        /// Largest time step, s (default: 1/2000 of the loading time).
+        #[arg(long)]
+        dt: Option<f64>,
+        /// Output file stem: writes STEM.csv and STEM_*.png.
+        #[arg(long, default_value = "material_point")]
+        out: PathBuf,
+    },
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum PathArg {
+    UniaxialStrain,
+    UniaxialStress,
+    SimpleShear,
 }
 
 /// Load a case from a file or the built-in set; returns the case and a name for it.
@@ -99,6 +131,9 @@ fn dispatch(cmd: Command) -> Result<()> {
             }
             Ok(())
         }
+        Command::MaterialPoint { material, case_file, path, rate, strain, dt, out } => {
+            material_point(&material, case_file.as_deref(), path, rate, strain, dt, &out)
+        }
         Command::Check { case_file, case, set } => {
             let (case, _, file) = load(&case_file, &case, &set)?;
             check(&case, &file)
@@ -111,6 +146,37 @@ fn dispatch(cmd: Command) -> Result<()> {
             run(&case, &file, &set, out_dir, force)
         }
     }
+}
+
+fn material_point(name: &str, case_file: Option<&Path>, path: PathArg, rate: f64, strain: f64, dt: Option<f64>, out: &Path) -> Result<()> {
+    use plugsim::material_point::{run, save_csv, save_plots, DriverConfig, LoadPath};
+    let mat = match case_file {
+        Some(f) => Case::load(f, &[])?.material(name),
+        None => plugsim::material::builtin(name),
+    }
+    .with_context(|| format!("unknown material '{name}' (built-in: {})", plugsim::material::builtin_names().join(", ")))?;
+    let load = match path {
+        PathArg::UniaxialStrain => LoadPath::UniaxialStrain,
+        PathArg::UniaxialStress => LoadPath::UniaxialStress,
+        PathArg::SimpleShear => LoadPath::SimpleShear,
+    };
+    let dt = dt.unwrap_or((strain / rate).abs() / 2000.0);
+    let cfg = DriverConfig { path: load, rate, final_strain: strain, dt, initial_temperature: None };
+    let records = run(&mat, &cfg)?;
+    let csv = out.with_extension("csv");
+    save_csv(&csv, &records)?;
+    let plots = save_plots(out, &records, load)?;
+    let last = records.last().context("no records")?;
+    println!("material point: {} steps to strain {:.4}", records.len() - 1, last.strain);
+    println!(
+        "  final: equivalent stress {:.4e} Pa, plastic strain {:.4}, temperature {:.1} K, damage {:.4}",
+        last.equivalent_stress, last.eps_p, last.temperature, last.damage
+    );
+    println!("  wrote {}", csv.display());
+    for p in plots {
+        println!("  wrote {}", p.display());
+    }
+    Ok(())
 }
 
 fn check(case: &Case, file: &str) -> Result<()> {

@@ -4,7 +4,7 @@
 //! results, and the analytic hypoelastic Jaumann solution of simple shear.
 
 use nalgebra::{Matrix3, Rotation3, Vector3};
-use plugsim::material::driver::{run, DriverConfig, LoadPath, Record};
+use plugsim::material_point::{run, DriverConfig, LoadPath, Record};
 use plugsim::material::johnson_cook::{JohnsonCook, RateForm};
 use plugsim::material::library::{weldox_460e, weldox_460e_borvik};
 use plugsim::material::{Constitutive, Elastic, Material, PointState, StepKinematics};

@@ -136,7 +136,8 @@ pub const MIN_FLOW_STRESS_RATIO: Real = 1e-9;
 pub const MIN_FAILURE_STRAIN: Real = 1e-6;
 
 /// Which strain-rate law multiplies the flow stress (SPEC §6, "Two rate laws").
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum RateForm {
     /// Classic Johnson–Cook, `τ̄ = g (1 + C ln(ε̄̇/ε̇₀))`, the form of \[RL10\]
     /// (with `ε̇₀ = 1 s⁻¹`). Flows (vanishingly slowly) at any stress.
@@ -147,7 +148,8 @@ pub enum RateForm {
 }
 
 /// Johnson–Cook failure-strain constants `D₁ … D₅` ([RL10, Eqs. (5.1)–(5.2)]).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct DamageConstants {
     /// `D₁`, dimensionless.
     pub d1: Real,
@@ -163,7 +165,8 @@ pub struct DamageConstants {
 
 /// Johnson–Cook thermo-viscoplastic material with isotropic hypoelasticity
 /// (SPEC §6). All fields SI.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct JohnsonCook {
     /// Reference mass density `ρ₀`, kg/m³.
     pub density: Real,
@@ -188,11 +191,13 @@ pub struct JohnsonCook {
     /// Reference strain rate `ε̇₀`, 1/s.
     pub reference_strain_rate: Real,
     /// Which rate law (log or power).
+    #[serde(default = "default_rate_form")]
     pub rate_form: RateForm,
     /// Specific heat `C_p`, J/(kg K).
     pub specific_heat: Real,
     /// Taylor–Quinney coefficient `χ`, fraction of plastic work turned into
     /// heat, in [0, 1]. `χ = 0` makes the model isothermal.
+    #[serde(default = "default_taylor_quinney")]
     pub taylor_quinney: Real,
     /// Linear thermal expansion coefficient `α`, 1/K.
     pub thermal_expansion: Real,
@@ -202,8 +207,10 @@ pub struct JohnsonCook {
     pub damage: DamageConstants,
     /// Scale the flow stress by `(1 − D)` (Børvik's coupled model). Default
     /// off, as in \[RL10\], where cracks, not softening, carry the failure.
+    #[serde(default = "default_false")]
     pub damage_coupling: bool,
     /// Tangent-method parameter `θ` in [0, 1]; see [`JohnsonCook::DEFAULT_THETA`].
+    #[serde(default = "default_theta")]
     pub theta: Real,
 }
 
@@ -237,6 +244,19 @@ pub struct ParameterError {
     pub value: Real,
     /// The admissible range, in words.
     pub requirement: &'static str,
+}
+
+fn default_taylor_quinney() -> Real {
+    0.9
+}
+fn default_false() -> bool {
+    false
+}
+fn default_theta() -> Real {
+    JohnsonCook::DEFAULT_THETA
+}
+fn default_rate_form() -> RateForm {
+    RateForm::Log
 }
 
 impl JohnsonCook {

@@ -5,7 +5,6 @@
 //! solver only ever sees [`Material`], an enum over the models, so that case
 //! files stay serializable and the hot loop stays monomorphic.
 
-pub mod driver;
 pub mod elastic;
 pub mod johnson_cook;
 pub mod library;
@@ -139,12 +138,12 @@ pub fn jaumann_update(tau: &Tensor3, tau_rate_objective: &Tensor3, w: &Tensor3, 
     tau + (tau_rate_objective + w * tau - tau * w) * dt
 }
 
-/// A built-in material by name (see `library`), if one exists.
-pub fn builtin(_name: &str) -> Option<Material> {
-    None
+/// A built-in material by name (see [`library`]), if one exists.
+pub fn builtin(name: &str) -> Option<Material> {
+    library::builtin(name)
 }
 
 /// Names of the built-in materials.
 pub fn builtin_names() -> Vec<&'static str> {
-    Vec::new()
+    library::NAMES.to_vec()
 }

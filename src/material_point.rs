@@ -12,7 +12,7 @@
 //!   [`save_plots`] renders them as PNG files.
 //!
 //! ```
-//! use plugsim::material::driver::{run, DriverConfig, LoadPath};
+//! use plugsim::material_point::{run, DriverConfig, LoadPath};
 //! use plugsim::material::library::builtin;
 //!
 //! let steel = builtin("weldox_460e").unwrap();
@@ -35,7 +35,7 @@ use std::ffi::OsString;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use super::{Constitutive, Material, PointState, StepKinematics};
+use crate::material::{Constitutive, Material, PointState, StepKinematics};
 use crate::io::plot::{save_line_plot, LinePlot, PlotError, Series};
 use crate::math::{mean_stress, von_mises, Real, Tensor3};
 
@@ -125,7 +125,7 @@ pub enum DriverError {
     },
     /// The material's parameters are invalid (all problems listed).
     #[error("invalid material: {}", .0.iter().map(|e| e.to_string()).collect::<Vec<_>>().join("; "))]
-    InvalidMaterial(Vec<super::johnson_cook::ParameterError>),
+    InvalidMaterial(Vec<crate::material::johnson_cook::ParameterError>),
     /// Uniaxial stress: the lateral-rate iteration did not bring `τ_yy` to zero.
     #[error("uniaxial stress: lateral stress {residual} Pa did not converge at step {step}")]
     LateralStressNotConverged { step: usize, residual: Real },
