@@ -2,7 +2,8 @@
 //! slave point is measured against, and the signed gap (SPEC §8,
 //! [RL10] §3).
 //!
-//! Coarse to fine, all in the body frame (`y = x − body position`):
+//! Coarse to fine, with the outline placed at a given body position `x_b`
+//! (the predicted one, in the contact stage):
 //! 1. the nearest outline vertex, from the body's vertex grid (never a loop
 //!    over all vertices);
 //! 2. of the two segments meeting at that vertex, the one onto which `y`
@@ -12,8 +13,11 @@
 //!    through; if neither qualifies, the vertex itself with the vertex normal
 //!    (see [`MasterFeature::Vertex`]).
 //!
-//! The gap is `g = (y − y_m)·n_m` with `n_m` the outward normal of the
-//! feature; `g < 0` is penetration.
+//! The gap is `g = (x − x_m)·n_m` with `x_m` a point of the feature and
+//! `n_m` its outward normal; `g < 0` is penetration. It is evaluated as
+//! `(x − (x_b + X_m))·n_m`, so its round-off is that of the coordinates near
+//! the contact, not of the body-frame coordinates (which the one-step force
+//! would amplify by `m/Δt²`).
 //!
 //! A slave's last pairing is reused while its local test succeeds
 //! ([`check_pairing`]): the segment still takes the projection (`λ ∈ [0, 1]`)
@@ -44,19 +48,20 @@ use crate::math::{Real, Vec2};
 pub struct Projection {
     /// The feature.
     pub feature: MasterFeature,
-    /// Signed gap `g = (y − y_m)·n_m`, m; negative when penetrating.
+    /// Signed gap `g = (x − x_m)·n_m`, m; negative when penetrating.
     pub gap: Real,
     /// Outward unit normal `n_m` of the feature.
     pub normal: Vec2,
 }
 
-/// Projection parameter and gap of body-frame point `y` on segment `k`.
+/// Projection parameter and gap of point `x` on segment `k` of the body
+/// placed at `at`.
 #[inline]
-fn on_segment(body: &RigidBody, k: usize, y: &Vec2) -> (Real, Real) {
+fn on_segment(body: &RigidBody, at: &Vec2, k: usize, x: &Vec2) -> (Real, Real) {
     let o = body.outline();
     let a = o[k];
     let t = o[(k + 1) % o.len()] - a;
-    let d = y - a;
+    let d = x - (at + a);
     (d.dot(&t) / t.norm_squared(), d.dot(&body.segment_normal(k)))
 }
 
@@ -71,39 +76,40 @@ fn segment(body: &RigidBody, k: usize, gap: Real) -> Projection {
 }
 
 /// Fine stage: choose between the two segments at vertex `v` (module doc).
-fn select_at_vertex(body: &RigidBody, v: usize, y: &Vec2) -> Projection {
+fn select_at_vertex(body: &RigidBody, at: &Vec2, v: usize, x: &Vec2) -> Projection {
     let n = body.vertex_count();
     let (kp, kn) = ((v + n - 1) % n, v);
-    let (lp, gp) = on_segment(body, kp, y);
-    let (ln, gn) = on_segment(body, kn, y);
+    let (lp, gp) = on_segment(body, at, kp, x);
+    let (ln, gn) = on_segment(body, at, kn, x);
     match (takes(lp), takes(ln)) {
         (true, true) if gp > gn => segment(body, kp, gp),
         (true, true) | (false, true) => segment(body, kn, gn),
         (true, false) => segment(body, kp, gp),
         (false, false) => {
             let normal = body.vertex_normal(v);
-            Projection { feature: MasterFeature::Vertex(v as u32), gap: (y - body.outline()[v]).dot(&normal), normal }
+            let gap = (x - (at + body.outline()[v])).dot(&normal);
+            Projection { feature: MasterFeature::Vertex(v as u32), gap, normal }
         }
     }
 }
 
-/// Pair body-frame point `y` with a feature of `body`'s outline: nearest
+/// Pair point `x` with a feature of `body`'s outline placed at `at`: nearest
 /// vertex from the vertex grid, then [`select_at_vertex`]'s rule.
-pub fn search_rigid_polygon(body: &RigidBody, y: &Vec2) -> Option<Projection> {
-    let (v, _) = body.vertex_grid().nearest(y)?;
-    Some(select_at_vertex(body, v, y))
+pub fn search_rigid_polygon(body: &RigidBody, at: &Vec2, x: &Vec2) -> Option<Projection> {
+    let (v, _) = body.vertex_grid().nearest(&(x - at))?;
+    Some(select_at_vertex(body, at, v, x))
 }
 
 /// Reference for [`search_rigid_polygon`] with the nearest vertex found by an
 /// O(n) loop (ties to the smallest index, as the grid). For tests.
-pub fn search_rigid_polygon_brute_force(body: &RigidBody, y: &Vec2) -> Option<Projection> {
-    let (v, _) = super::grid::nearest_brute_force(body.outline(), y)?;
-    Some(select_at_vertex(body, v, y))
+pub fn search_rigid_polygon_brute_force(body: &RigidBody, at: &Vec2, x: &Vec2) -> Option<Projection> {
+    let (v, _) = super::grid::nearest_brute_force(body.outline(), &(x - at))?;
+    Some(select_at_vertex(body, at, v, x))
 }
 
 /// Local test of a previous pairing (module doc): the projection on
 /// `feature` if it still holds, `None` if a fresh search is needed.
-pub fn check_pairing(body: &RigidBody, feature: MasterFeature, y: &Vec2) -> Option<Projection> {
+pub fn check_pairing(body: &RigidBody, at: &Vec2, feature: MasterFeature, x: &Vec2) -> Option<Projection> {
     let n = body.vertex_count();
     match feature {
         MasterFeature::Segment(k) => {
@@ -111,12 +117,12 @@ pub fn check_pairing(body: &RigidBody, feature: MasterFeature, y: &Vec2) -> Opti
             if k >= n {
                 return None;
             }
-            let (l, g) = on_segment(body, k, y);
+            let (l, g) = on_segment(body, at, k, x);
             if !takes(l) {
                 return None;
             }
             for j in [(k + n - 1) % n, (k + 1) % n] {
-                let (lj, gj) = on_segment(body, j, y);
+                let (lj, gj) = on_segment(body, at, j, x);
                 if takes(lj) && gj > g {
                     return None;
                 }
@@ -128,7 +134,7 @@ pub fn check_pairing(body: &RigidBody, feature: MasterFeature, y: &Vec2) -> Opti
             if v >= n {
                 return None;
             }
-            let p = select_at_vertex(body, v, y);
+            let p = select_at_vertex(body, at, v, x);
             matches!(p.feature, MasterFeature::Vertex(_)).then_some(p)
         }
     }
@@ -146,37 +152,37 @@ mod tests {
     #[test]
     fn below_the_nose_pairs_with_the_nose() {
         let b = rect();
-        let p = search_rigid_polygon(&b, &Vec2::new(3.0, -41.0)).unwrap();
+        let p = search_rigid_polygon(&b, &Vec2::zeros(), &Vec2::new(3.0, -41.0)).unwrap();
         assert_eq!(p.feature, MasterFeature::Segment(0));
         assert!((p.gap - 1.0).abs() < 1e-12);
-        let p = search_rigid_polygon(&b, &Vec2::new(-9.0, -39.5)).unwrap();
+        let p = search_rigid_polygon(&b, &Vec2::zeros(), &Vec2::new(-9.0, -39.5)).unwrap();
         assert_eq!(p.feature, MasterFeature::Segment(0));
         assert!((p.gap + 0.5).abs() < 1e-12);
         // inside near the corner but closer to the side: the side
-        let p = search_rigid_polygon(&b, &Vec2::new(9.8, -39.0)).unwrap();
+        let p = search_rigid_polygon(&b, &Vec2::zeros(), &Vec2::new(9.8, -39.0)).unwrap();
         assert_eq!(p.feature, MasterFeature::Segment(1));
         assert!((p.gap + 0.2).abs() < 1e-12);
         // flush with the side, below the nose: λ = 1 on the nose is accepted
-        let p = search_rigid_polygon(&b, &Vec2::new(10.0, -40.5)).unwrap();
+        let p = search_rigid_polygon(&b, &Vec2::zeros(), &Vec2::new(10.0, -40.5)).unwrap();
         assert_eq!(p.feature, MasterFeature::Segment(0));
     }
 
     #[test]
     fn vertex_pairing_outside_a_convex_corner() {
         let b = rect();
-        let p = search_rigid_polygon(&b, &Vec2::new(11.0, -41.0)).unwrap();
+        let p = search_rigid_polygon(&b, &Vec2::zeros(), &Vec2::new(11.0, -41.0)).unwrap();
         assert_eq!(p.feature, MasterFeature::Vertex(1));
         assert!((p.gap - 2.0 / 2f64.sqrt()).abs() < 1e-12);
-        assert!(check_pairing(&b, MasterFeature::Vertex(1), &Vec2::new(11.0, -41.0)).is_some());
-        assert!(check_pairing(&b, MasterFeature::Vertex(1), &Vec2::new(9.0, -41.0)).is_none());
+        assert!(check_pairing(&b, &Vec2::zeros(), MasterFeature::Vertex(1), &Vec2::new(11.0, -41.0)).is_some());
+        assert!(check_pairing(&b, &Vec2::zeros(), MasterFeature::Vertex(1), &Vec2::new(9.0, -41.0)).is_none());
     }
 
     #[test]
     fn reuse_fails_when_a_neighbour_takes_over() {
         let b = rect();
         let y = Vec2::new(9.9, -39.0); // inside, 0.1 from the side, 1.0 from the nose
-        assert!(check_pairing(&b, MasterFeature::Segment(0), &y).is_none());
-        assert_eq!(check_pairing(&b, MasterFeature::Segment(1), &y).unwrap().feature, MasterFeature::Segment(1));
-        assert!(check_pairing(&b, MasterFeature::Segment(9), &y).is_none());
+        assert!(check_pairing(&b, &Vec2::zeros(), MasterFeature::Segment(0), &y).is_none());
+        assert_eq!(check_pairing(&b, &Vec2::zeros(), MasterFeature::Segment(1), &y).unwrap().feature, MasterFeature::Segment(1));
+        assert!(check_pairing(&b, &Vec2::zeros(), MasterFeature::Segment(9), &y).is_none());
     }
 }

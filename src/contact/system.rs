@@ -366,15 +366,15 @@ impl ContactSystem {
             let last = self.slaves.pairing(k);
             let mut found: Option<Pairing> = None;
             for (b, body) in self.bodies.iter().enumerate() {
-                let y = x - self.predicted_position[b];
-                if !body.bounding_box_contains(&y) {
+                let at = self.predicted_position[b];
+                if !body.bounding_box_contains(&(x - at)) {
                     continue;
                 }
                 let reuse = match last {
-                    Some(p) if p.body as usize == b => check_pairing(body, p.feature, &y),
+                    Some(p) if p.body as usize == b => check_pairing(body, &at, p.feature, &x),
                     _ => None,
                 };
-                let Some(Projection { feature, gap, normal }) = reuse.or_else(|| search_rigid_polygon(body, &y)) else {
+                let Some(Projection { feature, gap, normal }) = reuse.or_else(|| search_rigid_polygon(body, &at, &x)) else {
                     continue;
                 };
                 let pairing = Pairing { body: b as u32, feature };
