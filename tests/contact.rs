@@ -192,31 +192,35 @@ proptest! {
         let body = RigidBody::new("star", outline, position, Vec2::zeros(), 1.0).unwrap();
         for _ in 0..200 {
             let y = Vec2::new(3.0 * splitmix(&mut s) - 1.5, 3.0 * splitmix(&mut s) - 1.5);
-            prop_assert_eq!(search_rigid_polygon(&body, &position, &y), search_rigid_polygon_brute_force(&body, &position, &y));
+            let d = y + Vec2::new(splitmix(&mut s) - 0.5, splitmix(&mut s) - 0.5) * 0.1;
+            prop_assert_eq!(search_rigid_polygon(&body, &position, &y, &d), search_rigid_polygon_brute_force(&body, &position, &y, &d));
         }
         // and the corner/abreast cases of a rectangle, on its exact lattice
         let rect = RigidBody::new("r", rectangle_outline(2.0, 8.0), Vec2::zeros(), Vec2::zeros(), 1.0).unwrap();
         for k in 0..121 {
             let y = Vec2::new(-1.5 + 0.3 * (k % 11) as Real, -4.5 + 0.9 * (k / 11) as Real);
             let o = Vec2::zeros();
-            prop_assert_eq!(search_rigid_polygon(&rect, &o, &y), search_rigid_polygon_brute_force(&rect, &o, &y));
+            prop_assert_eq!(search_rigid_polygon(&rect, &o, &y, &y), search_rigid_polygon_brute_force(&rect, &o, &y, &y));
         }
     }
 }
 
 /// Reusing last step's pairing while its local test holds gives the fresh
-/// search's answer on a rectangle, for points circling a corner in and out.
+/// search's answer on a rectangle for points circling a corner outside it
+/// (inside, reuse deliberately keeps the face crossed: `search` module doc).
 #[test]
-fn pairing_reuse_agrees_with_fresh_search_while_sliding() {
+fn pairing_reuse_agrees_with_fresh_search_outside() {
     let body = RigidBody::new("p", rectangle_outline(20.0, 80.0), Vec2::zeros(), Vec2::zeros(), 1.0).unwrap();
+    let o = Vec2::zeros();
     let mut last: Option<MasterFeature> = None;
     let mut reused = 0;
-    for k in 0..2000 {
-        let t = k as Real * 0.01;
-        let r = 0.5 + 2.0 * (0.7 * t).sin().abs();
+    for k in 0..4000 {
+        // a path around the corner (10, -40), always outside the body
+        let t = -0.5 * std::f64::consts::PI + 0.75 * std::f64::consts::PI * (k as Real / 4000.0);
+        let r = 0.2 + 2.0 * (7.0 * t).sin().abs();
         let y = Vec2::new(10.0, -40.0) + Vec2::new(t.cos(), t.sin()) * r;
-        let o = Vec2::zeros();
-        let fresh = search_rigid_polygon(&body, &o, &y).unwrap();
+        let fresh = search_rigid_polygon(&body, &o, &y, &y).unwrap();
+        assert!(fresh.gap > 0.0);
         let got = match last.and_then(|f| check_pairing(&body, &o, f, &y)) {
             Some(p) => {
                 reused += 1;
@@ -227,7 +231,7 @@ fn pairing_reuse_agrees_with_fresh_search_while_sliding() {
         assert_eq!(got, fresh, "step {k}, y = {y:?}");
         last = Some(got.feature);
     }
-    assert!(reused > 1500, "reuse should be the common case, got {reused}");
+    assert!(reused > 3900, "reuse should be the common case, got {reused}");
 }
 
 // ---------------------------------------------------------------- forces
@@ -267,7 +271,7 @@ fn one_step_normal_force_puts_free_particle_on_surface() {
     let c = sys.contacts()[0];
     assert_eq!(c.pairing.feature, MasterFeature::Segment(0));
     let x = p.x0[0] + p.u[0];
-    let g_end = search_rigid_polygon(&sys.bodies[0], &sys.bodies[0].position, &x).unwrap().gap;
+    let g_end = search_rigid_polygon(&sys.bodies[0], &sys.bodies[0].position, &x, &x).unwrap().gap;
     assert!(g_end.abs() <= 1e-12 * c.gap.abs(), "end gap {g_end:e}, predicted {:e}", c.gap);
 }
 
@@ -412,7 +416,7 @@ fn spreading_conserves_the_total_force() {
         }
         // a diamond pressed into the top surface: inclined normals
         let diamond = vec![Vec2::new(0.0, -2.0 * h), Vec2::new(2.0 * h, 0.0), Vec2::new(0.0, 2.0 * h), Vec2::new(-2.0 * h, 0.0)];
-        let body = RigidBody::new("diamond", diamond, Vec2::new(0.1 * h, 1.0 * h), Vec2::new(0.0, -50.0), 1.0).unwrap();
+        let body = RigidBody::new("diamond", diamond, Vec2::new(0.1 * h, 0.5 * h), Vec2::new(0.0, -50.0), 1.0).unwrap();
         let slaves = SlaveSet::detect(&p.x0, &p.spacing, &SurfaceDetection::default()).unwrap();
         let params = ContactParameters { spreading: mode, friction_coefficient: 0.3, ..ContactParameters::default() };
         let mut sys = ContactSystem::new(vec![body], slaves, params).unwrap();
@@ -591,4 +595,209 @@ fn bad_inputs_are_errors_not_panics() {
     assert!(matches!(sys.compute_forces(&StepInput::from_particles(&p, None, 1e-6), &mut f), Err(ContactError::SlaveOutOfRange { .. })));
     let bad = ContactParameters { friction_coefficient: -0.1, ..ContactParameters::default() };
     assert!(ContactSystem::new(vec![], SlaveSet::new(), bad).is_err());
+}
+
+// ---------------------------------------------------------------- comparison
+
+/// A linear-elastic RK block (plane strain, small strain, 2 × 2 Gauss points
+/// per background cell between particles: SPEC §4 with a linear material).
+struct ElasticBlock {
+    p: Particles,
+    shape: ShapeTable,
+    qp: ShapeTable,
+    qp_weight: Vec<Real>,
+    lame: (Real, Real),
+}
+
+impl ElasticBlock {
+    const YOUNG: Real = 200e9;
+    const POISSON: Real = 0.3;
+
+    fn new(xs: &[Real], ys: &[Real]) -> Self {
+        let p = lattice(xs, ys);
+        let shape = particle_table(&p);
+        let g = 0.5 / 3f64.sqrt();
+        let (mut pts, mut w) = (Vec::new(), Vec::new());
+        for j in 0..ys.len() - 1 {
+            for i in 0..xs.len() - 1 {
+                let (dx, dy) = (xs[i + 1] - xs[i], ys[j + 1] - ys[j]);
+                let c = Vec2::new(xs[i] + 0.5 * dx, ys[j] + 0.5 * dy);
+                for (sx, sy) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)] {
+                    pts.push(c + Vec2::new(sx * g * dx, sy * g * dy));
+                    w.push(0.25 * dx * dy);
+                }
+            }
+        }
+        let qp = rk_table(&p.x0, &p.volume, &p.support, &pts);
+        let (e, nu) = (Self::YOUNG, Self::POISSON);
+        let lame = (e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), e / (2.0 * (1.0 + nu)));
+        Self { p, shape, qp, qp_weight: w, lame }
+    }
+
+    /// Longitudinal wave speed `c_L = sqrt((λ + 2μ)/ρ)`.
+    fn wave_speed(&self) -> Real {
+        ((self.lame.0 + 2.0 * self.lame.1) / STEEL_DENSITY).sqrt()
+    }
+
+    /// `f_int,I = Σ_q σ_q ∇N_I(X_q) w_q` with `σ = λ tr ε I + 2μ ε`.
+    #[allow(non_snake_case)]
+    fn internal_force(&mut self) {
+        let (lam, mu) = self.lame;
+        let (t, p) = (&self.qp, &mut self.p);
+        p.f_int.fill(Vec2::zeros());
+        for q in 0..t.rows() {
+            // H = Σ U_J ⊗ ∇N_J (displacement gradient)
+            let (mut hxx, mut hxy, mut hyx, mut hyy) = (0.0, 0.0, 0.0, 0.0);
+            for e in t.range(q) {
+                let (U, g) = (p.u[t.index[e] as usize], t.grad[e]);
+                hxx += U.x * g.x;
+                hxy += U.x * g.y;
+                hyx += U.y * g.x;
+                hyy += U.y * g.y;
+            }
+            let (exy, tr) = (0.5 * (hxy + hyx), hxx + hyy);
+            let (sxx, syy, sxy) = (lam * tr + 2.0 * mu * hxx, lam * tr + 2.0 * mu * hyy, 2.0 * mu * exy);
+            let w = self.qp_weight[q];
+            for e in t.range(q) {
+                let g = t.grad[e];
+                p.f_int[t.index[e] as usize] += Vec2::new(sxx * g.x + sxy * g.y, sxy * g.x + syy * g.y) * w;
+            }
+        }
+    }
+}
+
+/// What one impact run measured.
+#[derive(Debug)]
+struct ImpactMetrics {
+    /// Mean contact force over the last two thirds of the run / `ρ c_L v W`.
+    force_ratio: Real,
+    /// Step-to-step variation of the force, `mean |F_{n+1} − F_n| / mean F`.
+    chatter: Real,
+    /// Largest penetration of the physical surface `x(X)` (particles and
+    /// midpoints under the punch) into the punch, after any step, / h.
+    physical_penetration: Real,
+    /// The same for the generalized positions `X_s + U_s` of the slaves, / h.
+    generalized_penetration: Real,
+    /// Energy the contact dissipated / work it did on the target.
+    dissipation: Real,
+    /// Most Gauss–Seidel sweeps in a step.
+    iterations: u32,
+}
+
+/// Rigid punch of width `punch_width` driven down at `v0` onto the top face
+/// (y = 0) of an elastic block, nose initially touching.
+fn punch_impact(mode: Spreading, xs: &[Real], ys: &[Real], uniaxial: bool, punch_width: Real, v0: Real, steps: usize) -> ImpactMetrics {
+    let h = ys[1] - ys[0];
+    let mut b = ElasticBlock::new(xs, ys);
+    let (nx, ny) = (xs.len(), ys.len());
+    for i in 0..b.p.len() {
+        if uniaxial {
+            b.p.flags[i].set(ParticleFlags::ON_AXIS); // u_x = 0: uniaxial strain
+        }
+        if i / nx == 0 {
+            b.p.flags[i].set(ParticleFlags::CLAMPED); // bottom row
+        }
+    }
+    let x_mid = 0.5 * (xs[0] + xs[nx - 1]);
+    let half = 0.5 * punch_width;
+    // sample points of the physical surface under the punch
+    let top: Vec<usize> = ((ny - 1) * nx..ny * nx).filter(|&i| (b.p.x0[i].x - x_mid).abs() <= half + 1e-12).collect();
+    let mut samples: Vec<Vec2> = top.iter().map(|&i| b.p.x0[i]).collect();
+    samples.extend(top.windows(2).map(|w| 0.5 * (b.p.x0[w[0]] + b.p.x0[w[1]])));
+    let surf = rk_table(&b.p.x0, &b.p.volume, &b.p.support, &samples);
+    let height = 0.5 * punch_width.max(4.0 * h);
+    let punch = RigidBody::new("punch", rectangle_outline(punch_width, height), Vec2::new(x_mid, 0.5 * height), Vec2::zeros(), 1.0)
+        .unwrap()
+        .with_prescribed_velocity(Vec2::new(0.0, -v0));
+    let slaves = SlaveSet::detect(&b.p.x0, &b.p.spacing, &SurfaceDetection::default()).unwrap();
+    let params = ContactParameters { spreading: mode, ..ContactParameters::default() };
+    let mut sys = ContactSystem::new(vec![punch], slaves, params).unwrap();
+    let dt = 0.3 * h / b.wave_speed();
+    let (mut f, mut forces) = (Vec::new(), Vec::new());
+    let (mut pen_phys, mut pen_gen): (Real, Real) = (0.0, 0.0);
+    let mut iterations = 0;
+    for _ in 0..steps {
+        b.internal_force();
+        iterations = iterations.max(step(&mut sys, &mut b.p, Some(&b.shape), dt, &mut f).iterations);
+        forces.push(sys.sample(0).unwrap().contact_force.y);
+        let (nose, centre) = (sys.bodies[0].position.y - 0.5 * height, sys.bodies[0].position.x);
+        // strictly under the nose: a point on the side face's line is not inside
+        let under = |x: &Vec2| (x.x - centre).abs() < half - 1e-6 * h;
+        for k in 0..samples.len() {
+            let x = samples[k] + surf.interpolate(k, &b.p.u);
+            if under(&x) {
+                pen_phys = pen_phys.max(x.y - nose);
+            }
+        }
+        for &i in &top {
+            let x = b.p.x0[i] + b.p.u[i];
+            if under(&x) {
+                pen_gen = pen_gen.max(x.y - nose);
+            }
+        }
+        assert!(b.p.u.iter().all(|u| u.iter().all(|c| c.is_finite())), "{mode:?}: finite");
+    }
+    let tail = &forces[steps / 3..];
+    let mean = tail.iter().sum::<Real>() / tail.len() as Real;
+    let chatter = tail.windows(2).map(|w| (w[1] - w[0]).abs()).sum::<Real>() / (tail.len() - 1) as Real / mean;
+    let width = if uniaxial { xs[nx - 1] - xs[0] } else { punch_width };
+    let s = sys.sample(0).unwrap();
+    ImpactMetrics {
+        force_ratio: mean / (STEEL_DENSITY * b.wave_speed() * v0 * width),
+        chatter,
+        physical_penetration: pen_phys.max(0.0) / h,
+        generalized_penetration: pen_gen.max(0.0) / h,
+        dissipation: -(s.work_on_particles + s.work_on_body) / s.work_on_particles,
+        iterations,
+    }
+}
+
+/// SPEC §8 asks to compare [RL10]'s inverse-distance spreading with the
+/// variationally consistent one and make the better the default.
+///
+/// (A) Uniaxial strain: a punch wider than the block drives its top at
+/// v = 50 m/s; the contact pressure must be `ρ c_L v` (plane wave) until the
+/// wave returns from the clamped bottom. (B) A punch 10 h wide (its corners
+/// abreast of particle columns) into a 40 h × 20 h block, laterally free.
+/// h = 1 mm, Δt = 0.3 h/c_L, 120 and 50 steps.
+///
+/// Measured (printed with `-- --nocapture`; force ratio / chatter /
+/// physical penetration [h] / contact dissipation / most sweeps):
+///
+/// | mode            | A                                   | B                                 |
+/// |-----------------|-------------------------------------|-----------------------------------|
+/// | None            | 1.006 / 0.029 / 1e-16 / 0.7 % / 2   | 1.15 / 0.019 / 0.070 / 1.4 % / 2  |
+/// | InverseDistance | 0.982 / 0.098 / 5e-8  / 2.4 % / 50  | 1.45 / 0.060 / 0.035 / 11 % / 46  |
+/// | ShapeFunction   | 1.006 / 0.029 / 3e-12 / 0.7 % / 25  | 1.25 / 0.019 / 0.024 / 1.5 % / 32 |
+///
+/// The shape-function mode leaves the least penetration of the physical
+/// surface where it is not trivially interpolating (B), with the smooth force
+/// and low dissipation of the point contact; inverse-distance spreading
+/// pushes interior particles, which shows as 3–8× the dissipation and force
+/// chatter. The assertions below guard that ranking.
+#[test]
+fn compare_spreading_on_elastic_impact() {
+    let h = 1e-3;
+    let run = |mode| {
+        let a = punch_impact(mode, &uniform(8, h, 0.0), &uniform(61, h, -60.0 * h), true, 20.0 * h, 50.0, 120);
+        let b = punch_impact(mode, &uniform(41, h, -20.0 * h), &uniform(21, h, -20.0 * h), false, 10.0 * h, 50.0, 50);
+        println!("{mode:?}\n  (A) uniaxial: {a:?}\n  (B) punch:    {b:?}");
+        (a, b)
+    };
+    let (none, id, sf) = (run(Spreading::None), run(Spreading::InverseDistance), run(Spreading::ShapeFunction));
+    for (a, _) in [&none, &id, &sf] {
+        // every mode transmits the plane-wave pressure on average
+        assert!((a.force_ratio - 1.0).abs() < 0.05, "force ratio {}", a.force_ratio);
+    }
+    // uniaxial: the face stays on the punch, without chatter, where the
+    // contact is point-wise exact
+    for (a, _) in [&none, &sf] {
+        assert!(a.physical_penetration < 1e-6 && a.chatter < 0.05 && a.dissipation < 0.02, "{a:?}");
+    }
+    // punch with corners: the ranking that makes ShapeFunction the default
+    let (sf_b, none_b, id_b) = (&sf.1, &none.1, &id.1);
+    assert!(sf_b.physical_penetration < 0.6 * none_b.physical_penetration, "{sf_b:?} vs {none_b:?}");
+    assert!(sf_b.physical_penetration < 0.8 * id_b.physical_penetration, "{sf_b:?} vs {id_b:?}");
+    assert!(sf_b.chatter < 0.5 * id_b.chatter && sf_b.dissipation < 0.3 * id_b.dissipation, "{sf_b:?} vs {id_b:?}");
+    assert!(sf.0.iterations < 50 && sf_b.iterations < 50, "Gauss-Seidel converged within the default cap");
 }

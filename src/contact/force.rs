@@ -65,56 +65,64 @@ pub enum Spreading {
     ShapeFunction,
 }
 
-/// Normal force magnitude that removes the predicted penetration `g̃ < 0`
-/// in one step: `f_n = m |g̃| / Δt²` (SPEC §8, [RL10, Eq. (3.x)] with the
-/// factor of SPEC §5's half-step velocities: module doc, # Deviations);
-/// zero when `g̃ ≥ 0`. `mass` is the effective mass of the gap point, kg.
+/// Normal force along `n_m` that removes the gap `g` of a point of effective
+/// mass `mass` (kg) in one step: `f_n = −m g / Δt²`, i.e. `m |g| / Δt²` for a
+/// penetration (SPEC §8, [RL10] §3 with the factor of SPEC §5's half-step
+/// velocities: module doc, # Deviations). Negative for an open gap; the
+/// caller keeps the total normal force non-negative. An infinite mass (a
+/// point that cannot move) gives no force.
 #[inline]
-pub fn normal_force_one_step(mass: Real, gap: Real, dt: Real) -> Real {
-    if gap < 0.0 {
-        mass * (-gap) / (dt * dt)
+pub fn one_step_normal_force(mass: Real, gap: Real, dt: Real) -> Real {
+    if mass.is_finite() {
+        -mass * gap / (dt * dt)
     } else {
         0.0
     }
 }
 
-/// Tangential force (signed, along the tangent whose velocity component is
-/// `tangential_velocity`) and whether the contact slips: the stick force
-/// `−m v_t / Δt` that cancels the relative tangential velocity over the
-/// step, capped by Coulomb's `μ |f_n|` (SPEC §8). `μ = 0` gives exactly no
-/// tangential force.
+/// Stick force along the tangent that cancels the relative tangential
+/// velocity `v_t` over one step: `−m v_t / Δt` (SPEC §8). Zero for an
+/// infinite mass.
 #[inline]
-pub fn friction_force(mass: Real, tangential_velocity: Real, dt: Real, mu: Real, normal_force: Real) -> (Real, bool) {
-    if mu == 0.0 {
-        return (0.0, tangential_velocity != 0.0);
-    }
-    let stick = -mass * tangential_velocity / dt;
-    let cap = mu * normal_force.abs();
-    if stick.abs() <= cap {
-        (stick, false)
+pub fn stick_force(mass: Real, tangential_velocity: Real, dt: Real) -> Real {
+    if mass.is_finite() {
+        -mass * tangential_velocity / dt
     } else {
-        (-cap * tangential_velocity.signum(), true)
+        0.0
+    }
+}
+
+/// Coulomb's cap on a trial tangential force: `(trial, false)` if
+/// `|trial| ≤ cap` (stick), else `(±cap, true)` with the trial's sign (slip).
+/// With `cap = 0` (μ = 0 or no normal force) the force is exactly zero and
+/// the contact slips unless the trial is zero.
+#[inline]
+pub fn coulomb_cap(trial: Real, cap: Real) -> (Real, bool) {
+    if trial.abs() <= cap {
+        (trial, false)
+    } else {
+        (cap.copysign(trial), true)
     }
 }
 
 /// Normalised inverse-distance weights (module doc): for candidate
 /// particles `(J, X_J)` around the slave at `x_s`, `w_J ∝ 1/max(|X_J − x_s|,
-/// floor)`, appended to `out` as `(J, w_J)` with `Σ w_J = 1`. `out` is
-/// cleared first; nothing is appended if there is no candidate.
+/// floor)`, appended to `out` as `(J, w_J)` with `Σ w_J = 1` over the
+/// appended entries; nothing is appended if there is no candidate.
 pub fn inverse_distance_weights(
     x_s: &Vec2,
     floor: Real,
     candidates: impl IntoIterator<Item = (u32, Vec2)>,
     out: &mut Vec<(u32, Real)>,
 ) {
-    out.clear();
+    let start = out.len();
     let mut total = 0.0;
     for (j, x) in candidates {
         let w = 1.0 / (x - x_s).norm().max(floor);
         total += w;
         out.push((j, w));
     }
-    for e in out.iter_mut() {
+    for e in &mut out[start..] {
         e.1 /= total;
     }
 }
@@ -124,30 +132,27 @@ mod tests {
     use super::*;
 
     #[test]
-    fn normal_force_is_zero_without_penetration() {
-        assert_eq!(normal_force_one_step(2.0, 1e-3, 1e-6), 0.0);
-        assert_eq!(normal_force_one_step(2.0, 0.0, 1e-6), 0.0);
-        assert!((normal_force_one_step(2.0, -1e-9, 1e-6) - 2.0e3).abs() < 1e-9);
-    }
-
-    #[test]
-    fn friction_sticks_below_the_cap_and_slips_above() {
-        // stick force 1 N, cap 0.5 * 4 = 2 N: stick
-        assert_eq!(friction_force(1.0, -1e-3, 1e-3, 0.5, 4.0), (1.0, false));
-        // stick force 10 N > cap 2 N: slip at the cap, opposing the motion
-        assert_eq!(friction_force(1.0, 1e-2, 1e-3, 0.5, -4.0), (-2.0, true));
-        assert_eq!(friction_force(1.0, 5.0, 1e-3, 0.0, 4.0), (0.0, true));
+    fn one_step_forces_and_the_coulomb_cap() {
+        assert!((one_step_normal_force(2.0, -1e-9, 1e-6) - 2.0e3).abs() < 1e-9);
+        assert!(one_step_normal_force(2.0, 1e-9, 1e-6) < 0.0);
+        assert_eq!(one_step_normal_force(Real::INFINITY, -1.0, 1.0), 0.0);
+        assert_eq!(stick_force(1.0, -1e-3, 1e-3), 1.0);
+        // stick below the cap, slip at the cap with the trial's sign above it
+        assert_eq!(coulomb_cap(1.0, 2.0), (1.0, false));
+        assert_eq!(coulomb_cap(-10.0, 2.0), (-2.0, true));
+        assert_eq!(coulomb_cap(5.0, 0.0), (0.0, true));
+        assert_eq!(coulomb_cap(0.0, 0.0), (0.0, false));
     }
 
     #[test]
     fn inverse_distance_weights_sum_to_one_and_floor_the_slave() {
-        let mut w = Vec::new();
+        let mut w = vec![(9, 0.25)];
         let xs = Vec2::new(0.0, 0.0);
         let cands = [(3u32, xs), (4, Vec2::new(1.0, 0.0)), (5, Vec2::new(0.0, -2.0))];
         inverse_distance_weights(&xs, 0.5, cands, &mut w);
-        let total: Real = w.iter().map(|e| e.1).sum();
-        assert!((total - 1.0).abs() < 1e-15);
+        let total: Real = w[1..].iter().map(|e| e.1).sum();
+        assert!((total - 1.0).abs() < 1e-15 && w[0] == (9, 0.25));
         // raw weights 2, 1, 0.5
-        assert!((w[0].1 - 2.0 / 3.5).abs() < 1e-15 && (w[2].1 - 0.5 / 3.5).abs() < 1e-15);
+        assert!((w[1].1 - 2.0 / 3.5).abs() < 1e-15 && (w[3].1 - 0.5 / 3.5).abs() < 1e-15);
     }
 }
