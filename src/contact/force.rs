@@ -1,46 +1,56 @@
 //! Contact forces of one slave: the one-step normal force, Coulomb friction
 //! and the spreading of the slave force over particles (SPEC §8,
-//! [RL10] §3).
+//! [RL10, §3]).
 //!
 //! # Time discretisation (which position and velocity)
 //! SPEC §5 integrates `V^{n+½} = V^{n−½} + Δt a^n`, `U^{n+1} = U^n + Δt V^{n+½}`.
 //! Splitting `a^n` into the contact-free part `a_free = (f_ext − f_int)/m` and
 //! the contact part gives the end-of-step position
 //! `x^{n+1} = x̃^{n+1} + Δt² f_c/m` with the *predictor*
-//! `Ṽ = V^{n−½} + Δt a_free`, `x̃^{n+1} = X + U^n + Δt Ṽ`.
+//! `Ṽ = V^{n−½} + Δt a_free`, `x̃^{n+1} = X + U^n + Δt Ṽ`
+//! (with the integrator's clamps and axis condition applied to `Ṽ`).
 //! The gap `g̃` is measured at `x̃^{n+1}` against the master surface
-//! predicted at the end of the step, and the force that leaves the slave
+//! predicted at the end of the step (body position `x_b + Δt V_b`, with its
+//! prescribed or current velocity), and the force that leaves the slave
 //! exactly on that surface is `f_n = m |g̃| / Δt²` along `n_m`
-//! ([`normal_force_one_step`]). Likewise the stick force uses the predicted
-//! relative velocity `Ṽ − V_body`, so that the slave's tangential velocity
-//! over the step matches the body's ([`friction_force`]).
+//! ([`one_step_normal_force`]). Likewise the stick force uses the predicted
+//! relative velocity `Ṽ − V_b`, so that the slave's tangential velocity over
+//! the step matches the body's ([`stick_force`], capped by [`coulomb_cap`]).
+//! A free body's own response to the reaction (`Δt² F/M`) is not predicted:
+//! it leaves a residual penetration of relative size `m_s/M` (≈ 1e-4 for a
+//! particle against the projectile), removed at the next step.
 //!
 //! # Deviations
-//! - **Factor 2.** [RL10] and SPEC §8 write `f_n = 2 m_s |g| / Δt²`. That is
-//!   the same condition ("remove the penetration in one step") for a Taylor
-//!   update `x^{n+1} = x^n + Δt v^n + ½ Δt² a^n` whose velocity `v^n` is not
-//!   itself changed by the contact acceleration. In the central difference
-//!   of SPEC §5 it is (`v^n = V^{n−½} + ½ Δt a^n` contains `a^n`, and the
-//!   position gains the full `Δt² a^n`), so the factor is 1 with the
+//! - **Factor 2.** [RL10, §3] and SPEC §8 write `f_n = 2 m_s |g| / Δt²`. That
+//!   is the same condition ("remove the penetration in one step") for a
+//!   Taylor update `x^{n+1} = x^n + Δt v^n + ½ Δt² a^n` whose velocity `v^n`
+//!   is not itself changed by the contact acceleration. In the central
+//!   difference of SPEC §5 it is (`v^n = V^{n−½} + ½ Δt a^n` contains `a^n`,
+//!   and the position gains the full `Δt² a^n`), so the factor is 1 with the
 //!   predictor above; the factor 2 would put the slave `|g̃|` *outside* the
 //!   surface, i.e. reflect its normal velocity every step (an elastic bounce
-//!   and contact chatter). Tests: `one_step_normal_force_puts_free_particle_on_surface`,
+//!   and contact chatter). Tests:
+//!   `one_step_normal_force_puts_free_particle_on_surface`,
 //!   `falling_particle_never_penetrates_a_wall`.
-//! - **Effective mass.** `m` is the mass that the force actually moves at
-//!   the point where the gap is measured: `m_s` for [`Spreading::None`] and
-//!   [`Spreading::InverseDistance`] (as [RL10]), and
-//!   `m_eff = (Σ_J N_J(X_s)² / m_J)⁻¹` for [`Spreading::ShapeFunction`],
-//!   whose gap point is `x(X_s) = X_s + Σ_J N_J(X_s) U_J` and whose force
-//!   `f_J = N_J F` moves that point by `Δt² F / m_eff`. With `m_s` there the
-//!   force would remove only `m_s / m_eff` (typically a third) of the
-//!   penetration. Test: `shape_function_contact_of_an_isolated_point_is_exact`.
+//! - **Effective mass.** `m` is the mass the force actually moves at the
+//!   point where the gap is measured: `m_s` for [`Spreading::None`],
+//!   `m_s / w_ss` for [`Spreading::InverseDistance`] (the slave keeps only
+//!   its own weight `w_ss` of the force; [RL10, §3] uses `m_s`, which removes
+//!   only that fraction), and `m_eff = (Σ_J N_J(X_s)² / m_J)⁻¹` for
+//!   [`Spreading::ShapeFunction`], whose gap point is
+//!   `x(X_s) = X_s + Σ_J N_J(X_s) U_J` and whose force `f_J = N_J F` moves
+//!   that point by `Δt² F / m_eff` (for a top-row particle of a uniform
+//!   lattice `m_eff = 2 m_s`: with `m_s` only half the penetration would go).
+//!   Where several slaves share particles the forces are solved together
+//!   (`ContactSystem::compute_forces`). Test:
+//!   `shape_function_contact_of_an_isolated_point_is_exact`.
 //! - **Inverse-distance weights.** `w_J ∝ 1 / max(|X_J − X_s|, ρ h_s)`
 //!   (reference distances, `ρ` = `inverse_distance_floor`, default ½), over
 //!   the particles of the slave's shape-function row that lie in the slave's
 //!   own window (`|X_J − X_s|_∞ < a_s`): the row respects crack visibility,
 //!   the window restricts it to "the particles in the slave's support"
-//!   ([RL10]). The floor is our choice: the slave itself is at distance 0,
-//!   which a pure inverse distance cannot weight. Test:
+//!   ([RL10, §3]). The floor is our choice: the slave itself is at distance
+//!   0, which a pure inverse distance cannot weight. Test:
 //!   `spreading_conserves_the_total_force`.
 
 use serde::{Deserialize, Serialize};
@@ -56,7 +66,7 @@ pub enum Spreading {
     /// on the slave particle.
     None,
     /// Gap at `X_s + U_s`; the force spread over the particles in the
-    /// slave's support with normalised inverse-distance weights ([RL10]).
+    /// slave's support with normalised inverse-distance weights ([RL10, §3]).
     InverseDistance,
     /// Variationally consistent: gap at the physical point
     /// `x(X_s) = X_s + Σ_J N_J(X_s) U_J`, force `f_J = N_J(X_s) F` (the
@@ -67,7 +77,7 @@ pub enum Spreading {
 
 /// Normal force along `n_m` that removes the gap `g` of a point of effective
 /// mass `mass` (kg) in one step: `f_n = −m g / Δt²`, i.e. `m |g| / Δt²` for a
-/// penetration (SPEC §8, [RL10] §3 with the factor of SPEC §5's half-step
+/// penetration (SPEC §8, [RL10, §3] with the factor of SPEC §5's half-step
 /// velocities: module doc, # Deviations). Negative for an open gap; the
 /// caller keeps the total normal force non-negative. An infinite mass (a
 /// point that cannot move) gives no force.
@@ -148,7 +158,11 @@ mod tests {
     fn inverse_distance_weights_sum_to_one_and_floor_the_slave() {
         let mut w = vec![(9, 0.25)];
         let xs = Vec2::new(0.0, 0.0);
-        let cands = [(3u32, xs), (4, Vec2::new(1.0, 0.0)), (5, Vec2::new(0.0, -2.0))];
+        let cands = [
+            (3u32, xs),
+            (4, Vec2::new(1.0, 0.0)),
+            (5, Vec2::new(0.0, -2.0)),
+        ];
         inverse_distance_weights(&xs, 0.5, cands, &mut w);
         let total: Real = w[1..].iter().map(|e| e.1).sum();
         assert!((total - 1.0).abs() < 1e-15 && w[0] == (9, 0.25));

@@ -14,7 +14,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::force::{coulomb_cap, inverse_distance_weights, one_step_normal_force, stick_force, Spreading};
+use super::force::{
+    coulomb_cap, inverse_distance_weights, one_step_normal_force, stick_force, Spreading,
+};
 use super::rigid::RigidBody;
 use super::search::{check_pairing, search_rigid_polygon, Projection};
 use super::slave::{Pairing, SlaveSet};
@@ -32,7 +34,7 @@ const PARTITION_TOLERANCE: Real = 1e-8;
 #[serde(deny_unknown_fields, default)]
 pub struct ContactParameters {
     /// Coulomb friction coefficient `μ ≥ 0`, dimensionless. Default 0
-    /// (SPEC §8: [RL10] runs frictionless).
+    /// (SPEC §8).
     pub friction_coefficient: Real,
     /// How slave forces reach the particles. Default
     /// [`Spreading::ShapeFunction`] (see the `contact` module doc).
@@ -69,18 +71,30 @@ impl ContactParameters {
     fn validate(&self) -> Result<(), ContactError> {
         let mu = self.friction_coefficient;
         if !(mu.is_finite() && mu >= 0.0) {
-            return Err(ContactError::InvalidParameter { name: "friction_coefficient", value: mu });
+            return Err(ContactError::InvalidParameter {
+                name: "friction_coefficient",
+                value: mu,
+            });
         }
         let r = self.inverse_distance_floor;
         if !(r.is_finite() && r > 0.0) {
-            return Err(ContactError::InvalidParameter { name: "inverse_distance_floor", value: r });
+            return Err(ContactError::InvalidParameter {
+                name: "inverse_distance_floor",
+                value: r,
+            });
         }
         if self.max_iterations == 0 {
-            return Err(ContactError::InvalidParameter { name: "max_iterations", value: 0.0 });
+            return Err(ContactError::InvalidParameter {
+                name: "max_iterations",
+                value: 0.0,
+            });
         }
         let t = self.tolerance;
         if !(t.is_finite() && t > 0.0) {
-            return Err(ContactError::InvalidParameter { name: "tolerance", value: t });
+            return Err(ContactError::InvalidParameter {
+                name: "tolerance",
+                value: t,
+            });
         }
         Ok(())
     }
@@ -148,16 +162,37 @@ impl<'a> StepInput<'a> {
         ];
         for (field, found) in lens {
             if found != n {
-                return Err(ContactError::LengthMismatch { field, expected: n, found });
+                return Err(ContactError::LengthMismatch {
+                    field,
+                    expected: n,
+                    found,
+                });
             }
         }
         if !(self.dt.is_finite() && self.dt > 0.0) {
-            return Err(ContactError::InvalidParameter { name: "dt", value: self.dt });
+            return Err(ContactError::InvalidParameter {
+                name: "dt",
+                value: self.dt,
+            });
         }
         if spreading != Spreading::None {
-            let table = self.shape.ok_or(ContactError::MissingShapeTable { spreading })?;
+            let table = self
+                .shape
+                .ok_or(ContactError::MissingShapeTable { spreading })?;
             if table.rows() != n {
-                return Err(ContactError::LengthMismatch { field: "shape rows", expected: n, found: table.rows() });
+                return Err(ContactError::LengthMismatch {
+                    field: "shape rows",
+                    expected: n,
+                    found: table.rows(),
+                });
+            }
+            let entries = table.index.len();
+            let consistent = table.value.len() == entries
+                && table.offsets.first() == Some(&0)
+                && table.offsets.windows(2).all(|w| w[0] <= w[1])
+                && table.offsets.last().is_some_and(|&e| e <= entries);
+            if !consistent {
+                return Err(ContactError::InvalidShapeTable);
             }
         }
         Ok(())
@@ -169,7 +204,11 @@ impl<'a> StepInput<'a> {
     fn predicted(&self, j: usize) -> Result<(Vec2, Vec2), ContactError> {
         let m = self.mass[j];
         if !(m.is_finite() && m > 0.0) {
-            return Err(ContactError::InvalidParticle { particle: j, field: "mass", value: m });
+            return Err(ContactError::InvalidParticle {
+                particle: j,
+                field: "mass",
+                value: m,
+            });
         }
         let flags = self.flags[j];
         let mut v = self.v[j] + (self.force_external[j] - self.force_internal[j]) * (self.dt / m);
@@ -260,8 +299,9 @@ pub struct ContactSystem {
     /// Cumulative contact work per body on the particles and on the body, J.
     work_on_particles: Vec<Real>,
     work_on_body: Vec<Real>,
-    /// `Δt` of a `compute_forces` not yet followed by `advance`.
-    pending_dt: Option<Real>,
+    /// `Δt` and particle count of a `compute_forces` not yet followed by
+    /// `advance`.
+    pending: Option<(Real, usize)>,
     /// Scratch: (particle, weight) of the gap point and of the spreading.
     /// Scratch: (particle, weight) rows of the gap points and, for
     /// inverse-distance spreading, of the forces; the pairs being solved.
@@ -272,7 +312,11 @@ pub struct ContactSystem {
 
 impl ContactSystem {
     /// A contact system; parameters are validated.
-    pub fn new(bodies: Vec<RigidBody>, slaves: SlaveSet, params: ContactParameters) -> Result<Self, ContactError> {
+    pub fn new(
+        bodies: Vec<RigidBody>,
+        slaves: SlaveSet,
+        params: ContactParameters,
+    ) -> Result<Self, ContactError> {
         params.validate()?;
         let nb = bodies.len();
         Ok(Self {
@@ -286,7 +330,7 @@ impl ContactSystem {
             predicted_position: vec![Vec2::zeros(); nb],
             work_on_particles: vec![0.0; nb],
             work_on_body: vec![0.0; nb],
-            pending_dt: None,
+            pending: None,
             gap_w: Vec::new(),
             force_w: Vec::new(),
             candidates: Vec::new(),
@@ -306,7 +350,10 @@ impl ContactSystem {
     /// Total cumulative contact work over all bodies, J (see
     /// [`BodySample::work_on_particles`] and [`BodySample::work_on_body`]).
     pub fn contact_work(&self) -> Real {
-        self.work_on_particles.iter().chain(&self.work_on_body).sum()
+        self.work_on_particles
+            .iter()
+            .chain(&self.work_on_body)
+            .sum()
     }
 
     /// Total linear momentum of the rigid bodies, kg m/s.
@@ -321,8 +368,8 @@ impl ContactSystem {
             position: body.position,
             velocity: body.velocity,
             contact_force: self.reaction.get(b).copied().unwrap_or_else(Vec2::zeros),
-            work_on_particles: self.work_on_particles[b],
-            work_on_body: self.work_on_body[b],
+            work_on_particles: self.work_on_particles.get(b).copied().unwrap_or(0.0),
+            work_on_body: self.work_on_body.get(b).copied().unwrap_or(0.0),
             active_contacts: self.active_per_body.get(b).copied().unwrap_or(0),
         })
     }
@@ -339,7 +386,8 @@ impl ContactSystem {
     /// Contact forces of this step (SPEC §8), written into `f_contact`
     /// (overwritten, one entry per particle). Call after the internal and
     /// external forces of the step are known and before the velocity update
-    /// (module doc); follow with [`Self::advance`].
+    /// (module doc); follow with [`Self::advance`]. On error, `f_contact`
+    /// and the pairing hints are unspecified and the step must not go on.
     ///
     /// 1. For each slave: predict its gap point and velocity at the end of
     ///    the step without contact (`force` module doc), pair it with each
@@ -360,25 +408,35 @@ impl ContactSystem {
     ///
     /// # Deviations
     /// SPEC §8 computes each slave's force alone. When the forces are
-    /// spread, neighbouring slaves move shared particles: alone, each force
-    /// over-corrects. With [`Spreading::ShapeFunction`] on a uniformly loaded
-    /// face every top particle receives about one slave force in total while
-    /// the isolated effective mass is about twice the particle's, so the
-    /// face is thrown out by the full penetration every step (measured: step
-    /// -to-step force variation 137 % of the mean in
-    /// `compare_spreading_on_elastic_impact`, case A, before this solve was
-    /// added; with inverse-distance weights and `m_s` the error has the other
-    /// sign: only ~60 % is removed). The sweeps make "remove the
-    /// penetration in one step" hold for the coupled set. Tests:
+    /// spread, neighbouring slaves move shared particles, and forces computed
+    /// alone no longer remove the penetration. With
+    /// [`Spreading::ShapeFunction`] on a uniformly loaded face each top
+    /// particle receives about one whole slave force while the isolated
+    /// effective mass is about twice the particle's, so the face was thrown
+    /// out by the full penetration every step: before this solve was added,
+    /// `compare_spreading_on_elastic_impact` (case A) measured a step-to-step
+    /// force variation of 137 % of the mean (2.9 % with it). With
+    /// inverse-distance weights and [RL10, §3]'s `m_s` the error has the other
+    /// sign (the slave keeps only part of its force): residual penetration
+    /// 1.6e-3 h in case A, 5e-8 h with the solve. Tests:
     /// `compare_spreading_on_elastic_impact`,
     /// `shape_function_contact_of_an_isolated_point_is_exact`.
-    pub fn compute_forces(&mut self, input: &StepInput, f_contact: &mut [Vec2]) -> Result<StepReport, ContactError> {
+    pub fn compute_forces(
+        &mut self,
+        input: &StepInput,
+        f_contact: &mut [Vec2],
+    ) -> Result<StepReport, ContactError> {
+        self.pending = None;
         self.params.validate()?;
         let spreading = self.params.spreading;
         input.validate(spreading)?;
         let n = input.x0.len();
         if f_contact.len() != n {
-            return Err(ContactError::LengthMismatch { field: "f_contact", expected: n, found: f_contact.len() });
+            return Err(ContactError::LengthMismatch {
+                field: "f_contact",
+                expected: n,
+                found: f_contact.len(),
+            });
         }
         self.slaves.check_indices(n)?;
         self.resize_per_body();
@@ -413,7 +471,10 @@ impl ContactSystem {
                 vel += v_pred * w;
             }
             if !x.iter().chain(vel.iter()).all(|c| c.is_finite()) {
-                return Err(ContactError::NonFinite { particle: s, quantity: "predicted position or velocity" });
+                return Err(ContactError::NonFinite {
+                    particle: s,
+                    quantity: "predicted position or velocity",
+                });
             }
             let last = self.slaves.pairing(k);
             let mut found: Option<Pairing> = None;
@@ -429,10 +490,18 @@ impl ContactSystem {
                 };
                 let from = x_now - body.position + at;
                 let fresh = || search_rigid_polygon(body, &at, &x, &from);
-                let Some(Projection { feature, gap, normal }) = reuse.or_else(fresh) else {
+                let Some(Projection {
+                    feature,
+                    gap,
+                    normal,
+                }) = reuse.or_else(fresh)
+                else {
                     continue;
                 };
-                let pairing = Pairing { body: b as u32, feature };
+                let pairing = Pairing {
+                    body: b as u32,
+                    feature,
+                };
                 found = Some(pairing);
                 if gap >= 0.0 {
                     continue;
@@ -441,7 +510,12 @@ impl ContactSystem {
                     Spreading::None | Spreading::ShapeFunction => gap_rows,
                     Spreading::InverseDistance => {
                         let start = self.force_w.len();
-                        inverse_distance_neighbours(input, s, self.params.inverse_distance_floor, &mut self.force_w)?;
+                        inverse_distance_neighbours(
+                            input,
+                            s,
+                            self.params.inverse_distance_floor,
+                            &mut self.force_w,
+                        )?;
                         (start as u32, self.force_w.len() as u32)
                     }
                 };
@@ -458,8 +532,11 @@ impl ContactSystem {
                     for &(jf, wf) in force_w {
                         if jf == j {
                             let r = mobility(input, j as usize);
-                            c_n += wg * wf * (normal.x * normal.x * r.x + normal.y * normal.y * r.y);
-                            c_t += wg * wf * (tangent.x * tangent.x * r.x + tangent.y * tangent.y * r.y);
+                            c_n +=
+                                wg * wf * (normal.x * normal.x * r.x + normal.y * normal.y * r.y);
+                            c_t += wg
+                                * wf
+                                * (tangent.x * tangent.x * r.x + tangent.y * tangent.y * r.y);
                         }
                     }
                 }
@@ -503,10 +580,15 @@ impl ContactSystem {
                 let gap = c.gap + dt * dt * c.normal.dot(&du);
                 let f_n = (c.f_n + one_step_normal_force(c.mass_normal, gap, dt)).max(0.0);
                 let v_t = c.slip_velocity + dt * c.tangent.dot(&du);
-                let (f_t, slipping) = coulomb_cap(c.f_t + stick_force(c.mass_tangent, v_t, dt), mu * f_n);
+                let (f_t, slipping) =
+                    coulomb_cap(c.f_t + stick_force(c.mass_tangent, v_t, dt), mu * f_n);
                 let delta = c.normal * (f_n - c.f_n) + c.tangent * (f_t - c.f_t);
                 if delta != Vec2::zeros() {
-                    let rows = if id { &self.force_w[..] } else { &self.gap_w[..] };
+                    let rows = if id {
+                        &self.force_w[..]
+                    } else {
+                        &self.gap_w[..]
+                    };
                     for &(j, w) in &rows[c.force_rows.0 as usize..c.force_rows.1 as usize] {
                         f_contact[j as usize] += delta * w;
                     }
@@ -517,7 +599,10 @@ impl ContactSystem {
             }
             if !(change.is_finite() && scale.is_finite()) {
                 let particle = self.candidates.first().map_or(0, |c| c.particle as usize);
-                return Err(ContactError::NonFinite { particle, quantity: "contact force" });
+                return Err(ContactError::NonFinite {
+                    particle,
+                    quantity: "contact force",
+                });
             }
             if change <= self.params.tolerance * scale {
                 break;
@@ -533,13 +618,18 @@ impl ContactSystem {
                 continue; // released by its neighbours
             }
             let force = c.normal * c.f_n + c.tangent * c.f_t;
-            let rows = if id { &self.force_w[..] } else { &self.gap_w[..] };
+            let rows = if id {
+                &self.force_w[..]
+            } else {
+                &self.gap_w[..]
+            };
             let mut applied = Vec2::zeros();
             for &(j, w) in &rows[c.force_rows.0 as usize..c.force_rows.1 as usize] {
                 let f = force * w;
                 f_contact[j as usize] += f;
                 applied += f;
-                self.applied.push((j, c.pairing.body, f, input.v[j as usize]));
+                self.applied
+                    .push((j, c.pairing.body, f, input.v[j as usize]));
             }
             let b = c.pairing.body as usize;
             self.reaction[b] -= applied;
@@ -557,8 +647,12 @@ impl ContactSystem {
                 force: applied,
             });
         }
-        self.pending_dt = Some(dt);
-        Ok(StepReport { active_contacts: self.contacts.len(), force_on_particles: total, iterations })
+        self.pending = Some((dt, n));
+        Ok(StepReport {
+            active_contacts: self.contacts.len(),
+            force_on_particles: total,
+            iterations,
+        })
     }
 
     /// Finish the step (module doc, stage 3): `v` holds the particles' new
@@ -578,13 +672,18 @@ impl ContactSystem {
     /// the same way to close the energy balance of SPEC §5. Test:
     /// `momentum_and_energy_with_a_free_body`.
     pub fn advance(&mut self, v: &[Vec2]) -> Result<(), ContactError> {
-        let dt = self.pending_dt.take().ok_or(ContactError::AdvanceWithoutForces)?;
-        for &(j, b, f, v_old) in &self.applied {
-            let v_new = v.get(j as usize).ok_or(ContactError::LengthMismatch {
+        let (dt, n) = self.pending.ok_or(ContactError::AdvanceWithoutForces)?;
+        if v.len() != n {
+            return Err(ContactError::LengthMismatch {
                 field: "v",
-                expected: j as usize + 1,
+                expected: n,
                 found: v.len(),
-            })?;
+            });
+        }
+        self.pending = None;
+        self.resize_per_body(); // bodies added since compute_forces feel no force
+        for &(j, b, f, v_old) in &self.applied {
+            let v_new = v[j as usize];
             self.work_on_particles[b as usize] += 0.5 * dt * f.dot(&(v_old + v_new));
         }
         for (b, body) in self.bodies.iter_mut().enumerate() {
@@ -629,7 +728,14 @@ fn mobility(input: &StepInput, j: usize) -> Vec2 {
         return Vec2::zeros();
     }
     let inv = 1.0 / input.mass[j];
-    Vec2::new(if flags.has(ParticleFlags::ON_AXIS) { 0.0 } else { inv }, inv)
+    Vec2::new(
+        if flags.has(ParticleFlags::ON_AXIS) {
+            0.0
+        } else {
+            inv
+        },
+        inv,
+    )
 }
 
 /// `1 / compliance`, infinite for a point that cannot move.
@@ -647,14 +753,20 @@ fn effective_mass(compliance: Real) -> Real {
 fn shape_row(input: &StepInput, s: usize, out: &mut Vec<(u32, Real)>) -> Result<(), ContactError> {
     // `validate` guarantees the table exists with one row per particle.
     let Some(table) = input.shape else {
-        return Err(ContactError::MissingShapeTable { spreading: Spreading::ShapeFunction });
+        return Err(ContactError::MissingShapeTable {
+            spreading: Spreading::ShapeFunction,
+        });
     };
     let n = input.x0.len();
     let mut sum = 0.0;
     for e in table.range(s) {
         let j = table.index[e];
         if j as usize >= n {
-            return Err(ContactError::ShapeIndexOutOfRange { row: s, particle: j as usize, particles: n });
+            return Err(ContactError::ShapeIndexOutOfRange {
+                row: s,
+                particle: j as usize,
+                particles: n,
+            });
         }
         sum += table.value[e];
         out.push((j, table.value[e]));
@@ -674,13 +786,19 @@ fn inverse_distance_neighbours(
     out: &mut Vec<(u32, Real)>,
 ) -> Result<(), ContactError> {
     let Some(table) = input.shape else {
-        return Err(ContactError::MissingShapeTable { spreading: Spreading::InverseDistance });
+        return Err(ContactError::MissingShapeTable {
+            spreading: Spreading::InverseDistance,
+        });
     };
     let n = input.x0.len();
     let xs = input.x0[s];
     let a = input.support[s];
     if let Some(e) = table.range(s).find(|&e| table.index[e] as usize >= n) {
-        return Err(ContactError::ShapeIndexOutOfRange { row: s, particle: table.index[e] as usize, particles: n });
+        return Err(ContactError::ShapeIndexOutOfRange {
+            row: s,
+            particle: table.index[e] as usize,
+            particles: n,
+        });
     }
     let candidates = table.range(s).map(|e| table.index[e]).filter_map(|j| {
         let d = input.x0[j as usize] - xs;
@@ -693,7 +811,11 @@ fn inverse_distance_neighbours(
     for &(j, _) in out.iter() {
         let m = input.mass[j as usize];
         if !(m.is_finite() && m > 0.0) {
-            return Err(ContactError::InvalidParticle { particle: j as usize, field: "mass", value: m });
+            return Err(ContactError::InvalidParticle {
+                particle: j as usize,
+                field: "mass",
+                value: m,
+            });
         }
     }
     Ok(())
