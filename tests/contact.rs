@@ -241,6 +241,23 @@ proptest! {
     }
 }
 
+/// At scale (a 4000-vertex outline, many cells, 2000 points near it) the
+/// grid still returns the brute-force pairing.
+#[test]
+fn search_matches_brute_force_on_a_fine_outline() {
+    let mut s = 99u64;
+    let outline = star_polygon(4000, &mut s);
+    let body = RigidBody::new("fine", outline, Vec2::zeros(), Vec2::zeros(), 1.0).unwrap();
+    for _ in 0..2000 {
+        let th = 2.0 * std::f64::consts::PI * splitmix(&mut s);
+        let y = Vec2::new(th.cos(), th.sin()) * (0.1 + 1.1 * splitmix(&mut s));
+        assert_eq!(
+            search_rigid_polygon(&body, &Vec2::zeros(), &y, &y),
+            search_rigid_polygon_brute_force(&body, &Vec2::zeros(), &y, &y)
+        );
+    }
+}
+
 /// Reusing last step's pairing while its local test holds gives the fresh
 /// search's answer on a rectangle for points circling a corner outside it
 /// (inside, reuse deliberately keeps the face crossed: `search` module doc).

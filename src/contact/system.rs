@@ -273,7 +273,7 @@ pub struct StepReport {
     pub active_contacts: usize,
     /// Total contact force applied to the particles, `Σ_J f_contact_J`, N.
     pub force_on_particles: Vec2,
-    /// Gauss–Seidel sweeps used.
+    /// Gauss–Seidel sweeps used (0 without penetrating pairs).
     pub iterations: u32,
 }
 
@@ -568,7 +568,12 @@ impl ContactSystem {
         let mu = self.params.friction_coefficient;
         let id = spreading == Spreading::InverseDistance;
         let mut iterations = 0;
-        for _ in 0..self.params.max_iterations {
+        let sweeps = if self.candidates.is_empty() {
+            0
+        } else {
+            self.params.max_iterations
+        };
+        for _ in 0..sweeps {
             iterations += 1;
             let (mut change, mut scale): (Real, Real) = (0.0, 0.0);
             for c in self.candidates.iter_mut() {
