@@ -28,8 +28,9 @@
 //!   alone it would not, and would be mistaken for a surface particle).
 //!   `c = 1.75` contains the axial neighbours with room for a grading ratio
 //!   up to 1.75 between adjacent spacings and the diagonal neighbours of a
-//!   square lattice (√2 ≈ 1.41), while staying below two spacings so a
-//!   particle does not see across a one-particle-thick gap.
+//!   square lattice (√2 ≈ 1.41), while staying below the second-neighbour
+//!   distance 2h: the test looks at the first ring only, so a notch or an
+//!   open crack one spacing wide still leaves its empty sector.
 //!
 //! Tests: `surface_of_uniform_rectangle`, `surface_of_graded_rectangle`,
 //! `surface_of_disc` (in `tests/contact.rs`).
