@@ -29,8 +29,10 @@
 //!   `c = 1.75` contains the axial neighbours with room for a grading ratio
 //!   up to 1.75 between adjacent spacings and the diagonal neighbours of a
 //!   square lattice (√2 ≈ 1.41), while staying below the second-neighbour
-//!   distance 2h: the test looks at the first ring only, so a notch or an
-//!   open crack one spacing wide still leaves its empty sector.
+//!   distance 2h, so only the first ring of a lattice counts.
+//! - Limitation: two faces closer than `c h` see each other (a fresh crack,
+//!   whose faces are `2δ ≪ h` apart), so crack faces are not found here; the
+//!   crack module adds them with `SlaveSet::add`.
 //!
 //! Tests: `surface_of_uniform_rectangle`, `surface_of_graded_rectangle`,
 //! `surface_of_disc` (in `tests/contact.rs`).
