@@ -2,6 +2,7 @@
 //! plugging and ductile fracture. See `ARCHITECTURE.md` for the module map
 //! and `SPEC.md` (shared) for the physics.
 
+pub mod contact;
 pub mod io;
 pub mod kernel;
 pub mod material;
