@@ -5,6 +5,7 @@
 //! The same structs build cases in tests; [`Case::resolved_toml`] writes the
 //! case with every default expanded, which each run stores beside its output.
 
+use crate::contact::{mass_axisymmetric, mass_plane_strain, rectangle_outline, ContactError, RigidBody};
 use crate::discretize::RectangleGrid;
 use crate::geometry::GeometryMode;
 use crate::material::{Elastic, JohnsonCook, Material, ThermalProperties};
@@ -33,6 +34,9 @@ pub struct Case {
     /// Rigid bodies (projectiles, anvils).
     #[serde(default)]
     pub rigid_bodies: Vec<RigidBodySpec>,
+    /// Contact with the rigid bodies (SPEC §8).
+    #[serde(default)]
+    pub contact: crate::contact::ContactParameters,
     /// Time integration.
     pub time: TimeSpec,
     /// Output.
@@ -379,12 +383,29 @@ impl Case {
             }
             match (rb.mass, rb.density) {
                 (Some(_), Some(_)) => add(k.clone(), "give either `mass` or `density`, not both".into()),
-                (None, None) if !rb.prescribed => add(k.clone(), "missing `mass` or `density`".into()),
+                (None, None) => add(k.clone(), "missing `mass` or `density`".into()),
                 (Some(m), None) => positive(&mut add, &format!("{k}.mass"), m, "kg"),
                 (None, Some(d)) => positive(&mut add, &format!("{k}.density"), d, "kg/m^3"),
-                _ => {}
+            }
+            if rb.outline.is_some() != rb.rectangle.is_some() && rb.mass.is_some() != rb.density.is_some() {
+                if let Err(e) = self.rigid_body(rb) {
+                    add(k.clone(), e.to_string());
+                }
             }
             finite2(&mut add, &format!("{k}.velocity"), rb.velocity, "m/s");
+        }
+        let mu = self.contact.friction_coefficient;
+        if !(mu.is_finite() && mu >= 0.0) {
+            add("contact.friction_coefficient".into(), format!("must be >= 0, got {mu}"));
+        }
+        if !(self.contact.inverse_distance_floor.is_finite() && self.contact.inverse_distance_floor > 0.0) {
+            add("contact.inverse_distance_floor".into(), format!("must be > 0, got {}", self.contact.inverse_distance_floor));
+        }
+        if self.contact.max_iterations == 0 {
+            add("contact.max_iterations".into(), "must be at least 1".into());
+        }
+        if !(self.contact.tolerance.is_finite() && self.contact.tolerance > 0.0) {
+            add("contact.tolerance".into(), format!("must be > 0, got {}", self.contact.tolerance));
         }
         positive(&mut add, "time.end", self.time.end, "s");
         if !(self.time.safety_factor > 0.0 && self.time.safety_factor <= 1.0) {
@@ -433,6 +454,33 @@ impl Case {
     /// TOML text of [`Case::resolved`].
     pub fn resolved_toml(&self) -> String {
         toml::to_string_pretty(&self.resolved()).unwrap_or_else(|e| format!("# could not serialize the case: {e}\n"))
+    }
+
+    /// The rigid body of a (validated) spec: outline, mass (from density by
+    /// area in plane strain, by volume of revolution in axisymmetry),
+    /// velocity, prescribed motion.
+    pub fn rigid_body(&self, rb: &RigidBodySpec) -> Result<RigidBody, ContactError> {
+        let (outline, position) = match (&rb.outline, &rb.rectangle) {
+            (Some(o), _) => (o.iter().map(|v| Vec2::new(v[0], v[1])).collect(), Vec2::zeros()),
+            (None, Some(r)) => (rectangle_outline(r.width, r.height), Vec2::new(r.center[0], r.center[1])),
+            (None, None) => (Vec::new(), Vec2::zeros()),
+        };
+        let mass = match (rb.mass, rb.density) {
+            (Some(m), _) => m,
+            (None, Some(rho)) => match self.geometry.mode {
+                GeometryMode::PlaneStrain => mass_plane_strain(&outline, rho)?,
+                GeometryMode::Axisymmetric => mass_axisymmetric(&outline, rho)?,
+            },
+            (None, None) => 0.0,
+        };
+        let velocity = Vec2::new(rb.velocity[0], rb.velocity[1]);
+        let body = RigidBody::new(rb.name.clone(), outline, position, velocity, mass)?;
+        Ok(if rb.prescribed { body.with_prescribed_velocity(velocity) } else { body })
+    }
+
+    /// All rigid bodies.
+    pub fn rigid_bodies(&self) -> Result<Vec<RigidBody>, ContactError> {
+        self.rigid_bodies.iter().map(|rb| self.rigid_body(rb)).collect()
     }
 
     /// The time-step rule.

@@ -5,7 +5,6 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use plugsim::case::Case;
 use plugsim::cases::{builtin_case, BUILTIN_CASES};
-use plugsim::model::Model;
 use plugsim::run::{execute, Progress, RunConfig, RunInfo};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -182,8 +181,7 @@ fn material_point(name: &str, case_file: Option<&Path>, path: PathArg, rate: f64
 fn check(case: &Case, file: &str) -> Result<()> {
     let resolved = case.resolved();
     let t = Instant::now();
-    let model = Model::build(resolved.geometry.mode, &resolved.body_setups()).context("building the discretization")?;
-    let sim = plugsim::step::Simulation::new(model, resolved.time_step_rule());
+    let sim = plugsim::run::build_simulation(&resolved).context("building the discretization")?;
     println!("{file}: OK ({})", if case.title.is_empty() { "untitled" } else { &case.title });
     println!("  geometry        {:?}", resolved.geometry.mode);
     for b in &sim.model.bodies {
@@ -196,7 +194,12 @@ fn check(case: &Case, file: &str) -> Result<()> {
             b.quad_points.len()
         );
     }
-    println!("  rigid bodies    {}", resolved.rigid_bodies.len());
+    if let Some(c) = &sim.contact {
+        for b in &c.bodies {
+            println!("  rigid body {:10} mass {:.6e} kg, velocity ({:.2}, {:.2}) m/s", b.name, b.mass, b.velocity.x, b.velocity.y);
+        }
+        println!("  contact slaves  {} surface particles", c.slaves.len());
+    }
     println!("  time step       {:.3e} s ({} steps to {:.3e} s)", sim.dt, (resolved.time.end / sim.dt).ceil(), resolved.time.end);
     println!("  mass            {:.6e} kg", sim.model.particles.total_mass());
     println!("  built in        {:.2} s", t.elapsed().as_secs_f64());
@@ -253,10 +256,11 @@ fn run(case: &Case, file: &str, set: &[String], out_dir: PathBuf, force: bool) -
     println!("plugsim run finished: {} steps to t = {:.4e} s (dt = {:.3e} s)", s.steps, s.time, s.dt);
     println!("  particles / quadrature points  {} / {}", s.particles, s.quadrature_points);
     println!(
-        "  energy: kinetic {:.4e} J, internal {:.4e} J, external work {:.4e} J, drift {:+.3} % (max {:.3} %)",
+        "  energy: kinetic {:.4e} J (rigid {:.4e} J), internal {:.4e} J, contact dissipation {:.4e} J, drift {:+.3} % (max {:.3} %)",
         s.energies.kinetic,
+        s.energies.rigid_kinetic,
         s.energies.internal,
-        s.energies.external_work,
+        s.energies.contact_dissipation(),
         100.0 * s.energies.drift(),
         100.0 * s.max_drift
     );

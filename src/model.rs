@@ -310,12 +310,7 @@ impl Model {
 /// Zero the components of `v` that `flags` hold fixed.
 #[inline]
 pub fn constrain(flags: ParticleFlags, v: &mut Vec2) {
-    if flags.has(ParticleFlags::FIX_X) {
-        v.x = 0.0;
-    }
-    if flags.has(ParticleFlags::FIX_Y) {
-        v.y = 0.0;
-    }
+    flags.constrain(v);
 }
 
 fn concat_tables(parts: Vec<ShapeTable>) -> ShapeTable {

@@ -13,9 +13,33 @@ use crate::model::Model;
 use crate::step::Simulation;
 use std::path::{Path, PathBuf};
 
-/// Columns of the history CSV, in order.
-pub const HISTORY_COLUMNS: &[&str] =
-    &["time", "step", "dt", "kinetic_energy", "internal_energy", "external_work", "total_energy", "energy_drift"];
+/// Columns of the history CSV that every run has, in order; each rigid
+/// body `NAME` adds `NAME_x, NAME_y` (m), `NAME_vx, NAME_vy` (m/s),
+/// `NAME_fx, NAME_fy` (contact force on the body, N) and `NAME_contacts`.
+pub const HISTORY_COLUMNS: &[&str] = &[
+    "time",
+    "step",
+    "dt",
+    "kinetic_energy",
+    "internal_energy",
+    "rigid_kinetic_energy",
+    "contact_work",
+    "contact_dissipation",
+    "total_energy",
+    "energy_drift",
+];
+
+/// Per-rigid-body history column suffixes.
+pub const RIGID_COLUMNS: &[&str] = &["x", "y", "vx", "vy", "fx", "fy", "contacts"];
+
+/// All history columns for a run with the given rigid bodies.
+pub fn history_columns(rigid_names: &[String]) -> Vec<String> {
+    let mut c: Vec<String> = HISTORY_COLUMNS.iter().map(|s| s.to_string()).collect();
+    for n in rigid_names {
+        c.extend(RIGID_COLUMNS.iter().map(|s| format!("{n}_{s}")));
+    }
+    c
+}
 
 /// Writes the snapshots and the history of one run into a directory.
 #[derive(Debug)]
@@ -30,12 +54,14 @@ pub struct OutputWriter {
 
 impl OutputWriter {
     /// Start the series `results.pvd` and `history.csv` in `dir` (which must exist).
-    pub fn create(dir: &Path, fields: &[String]) -> Result<Self, IoError> {
+    pub fn create(dir: &Path, fields: &[String], rigid_names: &[String]) -> Result<Self, IoError> {
+        let cols = history_columns(rigid_names);
+        let cols: Vec<&str> = cols.iter().map(|s| s.as_str()).collect();
         Ok(OutputWriter {
             dir: dir.to_path_buf(),
             fields: fields.to_vec(),
             series: PvdSeries::create(&dir.join("results.pvd"))?,
-            history: HistoryWriter::create(&dir.join("history.csv"), HISTORY_COLUMNS)?,
+            history: HistoryWriter::create(&dir.join("history.csv"), &cols)?,
             snapshots: 0,
         })
     }
@@ -58,16 +84,33 @@ impl OutputWriter {
     /// Append one history row.
     pub fn history_row(&mut self, sim: &Simulation) -> Result<(), IoError> {
         let e = &sim.energies;
-        self.history.write_row(&[
+        let mut row = vec![
             sim.time,
             sim.step as Real,
             sim.dt,
             e.kinetic,
             e.internal,
-            e.external_work,
+            e.rigid_kinetic,
+            e.contact_work,
+            e.contact_dissipation(),
             e.total(),
             e.drift(),
-        ])
+        ];
+        if let Some(c) = &sim.contact {
+            for b in 0..c.bodies.len() {
+                let s = c.sample(b).expect("body exists");
+                row.extend([
+                    s.position.x,
+                    s.position.y,
+                    s.velocity.x,
+                    s.velocity.y,
+                    s.contact_force.x,
+                    s.contact_force.y,
+                    s.active_contacts as Real,
+                ]);
+            }
+        }
+        self.history.write_row(&row)
     }
 }
 
@@ -144,8 +187,9 @@ pub fn plot_history(dir: &Path) -> Result<Vec<PathBuf>, crate::run::RunError> {
         series: vec![
             series("kinetic_energy", "kinetic"),
             series("internal_energy", "internal (stress work)"),
-            series("external_work", "external work"),
-            series("total_energy", "kinetic + internal - external work"),
+            series("rigid_kinetic_energy", "rigid bodies kinetic"),
+            series("contact_dissipation", "dissipated by contact"),
+            series("total_energy", "total (should stay constant)"),
         ],
         hlines: vec![],
     };

@@ -34,6 +34,16 @@ impl ParticleFlags {
     pub fn set(&mut self, f: u8) {
         self.0 |= f;
     }
+    /// Zero the components of `v` that these flags hold fixed.
+    #[inline]
+    pub fn constrain(self, v: &mut Vec2) {
+        if self.has(Self::FIX_X) {
+            v.x = 0.0;
+        }
+        if self.has(Self::FIX_Y) {
+            v.y = 0.0;
+        }
+    }
 }
 
 /// All particles of all deformable bodies.

@@ -4,6 +4,7 @@
 use crate::case::Case;
 use crate::io::IoError;
 use crate::math::Real;
+use crate::contact::{ContactSystem, SlaveSet, SurfaceDetection};
 use crate::model::{Model, ModelError};
 use crate::output::OutputWriter;
 use crate::step::{Simulation, SolverError};
@@ -75,6 +76,8 @@ pub enum RunError {
     OutputDir { path: PathBuf, message: String },
     #[error(transparent)]
     Model(#[from] ModelError),
+    #[error("contact setup: {0}")]
+    Contact(#[from] crate::contact::ContactError),
     #[error(transparent)]
     Io(#[from] IoError),
     #[error(transparent)]
@@ -104,6 +107,23 @@ pub fn prepare_output_dir(dir: &Path, force: bool) -> Result<(), RunError> {
     Ok(())
 }
 
+/// The simulation of a (resolved) case at t = 0: discretization, and
+/// contact with its rigid bodies if it has any (slaves: the surface
+/// particles, found geometrically).
+pub fn build_simulation(case: &Case) -> Result<Simulation, RunError> {
+    let model = Model::build(case.geometry.mode, &case.body_setups())?;
+    let rule = case.time_step_rule();
+    if case.rigid_bodies.is_empty() {
+        return Ok(Simulation::new(model, rule));
+    }
+    let bodies = case.rigid_bodies()?;
+    let slaves = SlaveSet::detect(&model.particles.x0, &model.particles.spacing, &SurfaceDetection::default())?;
+    let mut model = model;
+    slaves.mark_flags(&mut model.particles.flags)?;
+    let contact = ContactSystem::new(bodies, slaves, case.contact)?;
+    Ok(Simulation::with_contact(model, rule, contact))
+}
+
 /// Progress reports to the caller.
 pub enum Progress<'a> {
     /// The model is built; the loop is about to start.
@@ -117,7 +137,7 @@ pub fn execute(case: &Case, cfg: &RunConfig, progress: &mut dyn FnMut(Progress))
     let case = case.resolved();
     let t_setup = Instant::now();
     // Build before touching the disk: a case that cannot be discretized leaves nothing behind.
-    let model = Model::build(case.geometry.mode, &case.body_setups())?;
+    let mut sim = build_simulation(&case)?;
     prepare_output_dir(&cfg.out_dir, cfg.force)?;
     let write = |name: &str, text: String| -> Result<(), RunError> {
         let path = cfg.out_dir.join(name);
@@ -125,8 +145,8 @@ pub fn execute(case: &Case, cfg: &RunConfig, progress: &mut dyn FnMut(Progress))
     };
     write("case.resolved.toml", case.resolved_toml())?;
     write("run_info.toml", toml::to_string_pretty(&cfg.info).unwrap_or_default())?;
-    let mut sim = Simulation::new(model, case.time_step_rule());
-    let mut out = OutputWriter::create(&cfg.out_dir, &case.output.fields)?;
+    let rigid_names: Vec<String> = case.rigid_bodies.iter().map(|r| r.name.clone()).collect();
+    let mut out = OutputWriter::create(&cfg.out_dir, &case.output.fields, &rigid_names)?;
     let setup_wall = t_setup.elapsed();
 
     let end = case.time.end;

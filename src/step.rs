@@ -1,6 +1,7 @@
 //! The explicit time loop (SPEC §5): one documented stage order, stage
 //! timers, energy bookkeeping and instability detection.
 
+use crate::contact::{ContactError, ContactSystem, StepInput};
 use crate::material::{Constitutive, StepKinematics};
 use crate::math::{ddot, skew, sym, Real, Tensor3, Vec2};
 use crate::model::{constrain, Model};
@@ -18,35 +19,49 @@ pub enum TimeStepRule {
 }
 
 /// Energy account, J (per unit depth in plane strain).
+///
+/// The deformable bodies gain `kinetic + internal` from the work of contact
+/// forces on them (`contact_work`); rigid bodies gain `rigid_kinetic` from
+/// the reactions (`rigid_work`). The sum `contact_work + rigid_work` is the
+/// energy the contact itself dissipated (≤ 0 for a well-behaved contact).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Energies {
-    /// `½ Σ m_I |V_I|²` at the last full step (see `full_step_kinetic_energy`).
+    /// `½ Σ m_I |V_I|²` of the particles at the last full step (see
+    /// `full_step_kinetic_energy`).
     pub kinetic: Real,
     /// Stress work `∫∫ τ : d dV₀ dt` (elastic energy + plastic dissipation).
     pub internal: Real,
-    /// Work done on the bodies by external and contact forces.
-    pub external_work: Real,
-    /// Kinetic energy at the start of the run.
+    /// Kinetic energy of the rigid bodies.
+    pub rigid_kinetic: Real,
+    /// Work of the contact forces on the particles.
+    pub contact_work: Real,
+    /// Work of the contact reactions on the rigid bodies.
+    pub rigid_work: Real,
+    /// Total kinetic energy (particles + rigid bodies) at the start.
     pub initial_kinetic: Real,
 }
 
 impl Energies {
-    /// `kinetic + internal − external_work`, which stays at its initial value
-    /// in an exact integration.
+    /// `kinetic + rigid_kinetic + internal − (contact_work + rigid_work)`:
+    /// stays at `initial_kinetic` in an exact integration.
     pub fn total(&self) -> Real {
-        self.kinetic + self.internal - self.external_work
+        self.kinetic + self.rigid_kinetic + self.internal - (self.contact_work + self.rigid_work)
     }
-    /// Relative drift of the balance against the larger of the energy put in
-    /// and the initial kinetic energy.
+    /// Energy dissipated by the contact algorithm, `−(contact_work + rigid_work)`.
+    pub fn contact_dissipation(&self) -> Real {
+        -(self.contact_work + self.rigid_work)
+    }
+    /// Relative drift of the balance against the initial kinetic energy
+    /// (the energy put in).
     pub fn drift(&self) -> Real {
-        let scale = self.initial_kinetic.max(self.external_work.abs()).max(Real::MIN_POSITIVE);
-        (self.total() - self.initial_kinetic) / scale
+        (self.total() - self.initial_kinetic) / self.initial_kinetic.max(Real::MIN_POSITIVE)
     }
 }
 
 /// Wall time spent in each stage.
 #[derive(Clone, Debug, Default)]
 pub struct StageTimers {
+    pub contact: Duration,
     pub integration: Duration,
     pub material: Duration,
     pub internal_force: Duration,
@@ -57,6 +72,7 @@ impl StageTimers {
     /// `(name, duration)` pairs in stage order.
     pub fn list(&self) -> Vec<(&'static str, Duration)> {
         vec![
+            ("contact", self.contact),
             ("time integration", self.integration),
             ("velocity gradient + material", self.material),
             ("internal force", self.internal_force),
@@ -79,6 +95,13 @@ pub enum SolverError {
          time step too large or excessive distortion"
     )]
     Inverted { point: usize, x: Real, y: Real, jacobian: Real, step: u64, time: Real },
+    #[error("contact failed in step {step} (t = {time:.6e} s): {source}")]
+    Contact {
+        #[source]
+        source: ContactError,
+        step: u64,
+        time: Real,
+    },
     #[error(
         "particle {particle} moves at {speed:.3e} m/s, above the bound {bound:.3e} m/s, in step {step} \
          (t = {time:.6e} s); the solution has gone unstable (time step too large?)"
@@ -100,11 +123,28 @@ pub struct Simulation {
     pub timers: StageTimers,
     /// Speed above which a particle is declared runaway, m/s.
     pub speed_bound: Real,
+    /// Contact with rigid bodies, if the case has any.
+    pub contact: Option<ContactSystem>,
+    /// Contact forces of the current step, per particle (scratch).
+    pub f_contact: Vec<Vec2>,
     /// Per-point internal-energy increments of the last step (scratch).
     work_scratch: Vec<Real>,
 }
 
 impl Simulation {
+    /// Start a run at t = 0 with the step chosen by `rule`, with contact
+    /// against the rigid bodies of `contact`.
+    pub fn with_contact(model: Model, rule: TimeStepRule, contact: ContactSystem) -> Self {
+        let mut sim = Simulation::new(model, rule);
+        let rigid: Real = contact.bodies.iter().map(|b| 0.5 * b.mass * b.velocity.norm_squared()).sum();
+        sim.energies.rigid_kinetic = rigid;
+        sim.energies.initial_kinetic += rigid;
+        let vmax = contact.bodies.iter().map(|b| b.velocity.norm()).fold(0.0, Real::max);
+        sim.speed_bound = sim.speed_bound.max(10.0 * vmax);
+        sim.contact = Some(contact);
+        sim
+    }
+
     /// Start a run at t = 0 with the step chosen by `rule`.
     pub fn new(model: Model, rule: TimeStepRule) -> Self {
         let dt = match rule {
@@ -114,6 +154,7 @@ impl Simulation {
         let ke = kinetic_energy(&model.particles.mass, &model.particles.v);
         let vmax = model.particles.v.iter().map(|v| v.norm()).fold(0.0, Real::max);
         let nq = model.quad.len();
+        let np = model.particles.len();
         Simulation {
             model,
             time: 0.0,
@@ -122,13 +163,19 @@ impl Simulation {
             energies: Energies { kinetic: ke, initial_kinetic: ke, ..Default::default() },
             timers: StageTimers::default(),
             speed_bound: 10.0 * vmax.max(1000.0),
+            contact: None,
+            f_contact: vec![Vec2::zeros(); np],
             work_scratch: vec![0.0; nq],
         }
     }
 
     /// Advance one step `t → t + Δt`. Stages, in order:
-    /// 1. time integration: `a = (f_ext − f_int)/m`, `V ← V + Δt a`,
-    ///    `U ← U + Δt V`, constraints (SPEC §5);
+    /// 0. contact (SPEC §8): search and one-step forces from the contact-free
+    ///    predictor, which needs this step's `f_int(U^n)` — so contact runs
+    ///    after the previous step's internal force and before integration;
+    /// 1. time integration: `a = (f_ext + f_contact − f_int)/m`, `V ← V + Δt a`,
+    ///    `U ← U + Δt V`, constraints (SPEC §5); rigid bodies advance under
+    ///    the contact reactions;
     /// 2. velocity gradient and deformation gradient at each quadrature point
     ///    (`F` at the new step, `ℓ = Ḟ F_mid⁻¹` at mid-step; SPEC §2);
     /// 3. material update (SPEC §6) and `P w = τ F⁻ᵀ w_q`;
@@ -139,8 +186,11 @@ impl Simulation {
     /// as their modules land.
     pub fn step(&mut self) -> Result<(), SolverError> {
         let dt = self.dt;
+        let tc = Instant::now();
+        self.contact_forces(dt)?;
         let t0 = Instant::now();
         self.integrate(dt);
+        self.advance_rigid_bodies()?;
         let t1 = Instant::now();
         self.update_material(dt)?;
         let t2 = Instant::now();
@@ -151,6 +201,7 @@ impl Simulation {
         self.diagnose()?;
         self.energies.kinetic = self.full_step_kinetic_energy();
         let t4 = Instant::now();
+        self.timers.contact += t0 - tc;
         self.timers.integration += t1 - t0;
         self.timers.material += t2 - t1;
         self.timers.internal_force += t3 - t2;
@@ -158,13 +209,50 @@ impl Simulation {
         Ok(())
     }
 
+    /// Contact forces of this step into `f_contact` (zero without contact).
+    fn contact_forces(&mut self, dt: Real) -> Result<(), SolverError> {
+        let Some(contact) = self.contact.as_mut() else {
+            return Ok(());
+        };
+        let p = &self.model.particles;
+        self.f_contact.resize(p.len(), Vec2::zeros());
+        let input = StepInput::from_particles(p, Some(&self.model.particle_shape), dt);
+        contact
+            .compute_forces(&input, &mut self.f_contact)
+            .map_err(|source| SolverError::Contact { source, step: self.step + 1, time: self.time + dt })?;
+        Ok(())
+    }
+
+    /// Move the rigid bodies under the reactions and book the contact work.
+    fn advance_rigid_bodies(&mut self) -> Result<(), SolverError> {
+        let Some(contact) = self.contact.as_mut() else {
+            return Ok(());
+        };
+        contact
+            .advance(&self.model.particles.v)
+            .map_err(|source| SolverError::Contact { source, step: self.step + 1, time: self.time + self.dt })?;
+        let (mut wp, mut wb) = (0.0, 0.0);
+        for b in 0..contact.bodies.len() {
+            let s = contact.sample(b).expect("body exists");
+            wp += s.work_on_particles;
+            wb += s.work_on_body;
+        }
+        self.energies.contact_work = wp;
+        self.energies.rigid_work = wb;
+        self.energies.rigid_kinetic = contact.bodies.iter().map(|b| 0.5 * b.mass * b.velocity.norm_squared()).sum();
+        Ok(())
+    }
+
     /// Central-difference update of velocities and displacements.
     fn integrate(&mut self, dt: Real) {
         let p = &mut self.model.particles;
-        (p.v.par_iter_mut(), p.u.par_iter_mut(), p.a.par_iter_mut(), &p.f_int, &p.f_ext, &p.mass, &p.flags)
+        if self.f_contact.len() != p.len() {
+            self.f_contact.resize(p.len(), Vec2::zeros());
+        }
+        (p.v.par_iter_mut(), p.u.par_iter_mut(), p.a.par_iter_mut(), &p.f_int, &p.f_ext, &self.f_contact, &p.mass, &p.flags)
             .into_par_iter()
-            .for_each(|(v, u, a, fi, fe, m, flags)| {
-                let mut acc = (fe - fi) / *m;
+            .for_each(|(v, u, a, fi, fe, fc, m, flags)| {
+                let mut acc = (fe + fc - fi) / *m;
                 constrain(*flags, &mut acc);
                 *a = acc;
                 *v += acc * dt;
@@ -181,7 +269,8 @@ impl Simulation {
         let half = 0.5 * self.dt;
         (0..p.len())
             .map(|i| {
-                let mut acc = (p.f_ext[i] - p.f_int[i]) / p.mass[i];
+                let fc = self.f_contact.get(i).copied().unwrap_or_else(Vec2::zeros);
+                let mut acc = (p.f_ext[i] + fc - p.f_int[i]) / p.mass[i];
                 constrain(p.flags[i], &mut acc);
                 0.5 * p.mass[i] * (p.v[i] + acc * half).norm_squared()
             })

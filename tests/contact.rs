@@ -159,12 +159,8 @@ fn step(
     for i in 0..p.len() {
         let a = (p.f_ext[i] + f_c[i] - p.f_int[i]) / p.mass[i];
         p.v[i] += a * dt;
-        if p.flags[i].has(ParticleFlags::CLAMPED) {
-            p.v[i] = Vec2::zeros();
-        }
-        if p.flags[i].has(ParticleFlags::ON_AXIS) {
-            p.v[i].x = 0.0;
-        }
+        let flags = p.flags[i];
+        flags.constrain(&mut p.v[i]);
         p.u[i] += p.v[i] * dt;
     }
     sys.advance(&p.v).unwrap();
@@ -986,10 +982,10 @@ fn punch_impact(
     let (nx, ny) = (xs.len(), ys.len());
     for i in 0..b.p.len() {
         if uniaxial {
-            b.p.flags[i].set(ParticleFlags::ON_AXIS); // u_x = 0: uniaxial strain
+            b.p.flags[i].set(ParticleFlags::FIX_X); // u_x = 0: uniaxial strain
         }
         if i / nx == 0 {
-            b.p.flags[i].set(ParticleFlags::CLAMPED); // bottom row
+            b.p.flags[i].set(ParticleFlags::FIX_X | ParticleFlags::FIX_Y); // bottom row
         }
     }
     let x_mid = 0.5 * (xs[0] + xs[nx - 1]);

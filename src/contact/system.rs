@@ -120,7 +120,7 @@ pub struct StepInput<'a> {
     pub spacing: &'a [Real],
     /// RK support sizes `a`, m (inverse-distance neighbourhood).
     pub support: &'a [Real],
-    /// Flags: `CLAMPED` particles do not move, `ON_AXIS` ones not radially.
+    /// Flags: `FIX_X` / `FIX_Y` components are held (supports, the axis).
     pub flags: &'a [ParticleFlags],
     /// Shape functions at the particles, `N_J(X_I)` in row `I`; needed by
     /// [`Spreading::InverseDistance`] and [`Spreading::ShapeFunction`].
@@ -212,12 +212,7 @@ impl<'a> StepInput<'a> {
         }
         let flags = self.flags[j];
         let mut v = self.v[j] + (self.force_external[j] - self.force_internal[j]) * (self.dt / m);
-        if flags.has(ParticleFlags::CLAMPED) {
-            v = Vec2::zeros();
-        }
-        if flags.has(ParticleFlags::ON_AXIS) {
-            v.x = 0.0;
-        }
+        flags.constrain(&mut v);
         Ok((self.u[j] + v * self.dt, v))
     }
 }
@@ -728,19 +723,10 @@ struct Candidate {
 /// component; zero where the integrator holds the component).
 #[inline]
 fn mobility(input: &StepInput, j: usize) -> Vec2 {
-    let flags = input.flags[j];
-    if flags.has(ParticleFlags::CLAMPED) {
-        return Vec2::zeros();
-    }
     let inv = 1.0 / input.mass[j];
-    Vec2::new(
-        if flags.has(ParticleFlags::ON_AXIS) {
-            0.0
-        } else {
-            inv
-        },
-        inv,
-    )
+    let mut m = Vec2::new(inv, inv);
+    input.flags[j].constrain(&mut m);
+    m
 }
 
 /// `1 / compliance`, infinite for a point that cannot move.
