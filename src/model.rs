@@ -170,7 +170,8 @@ impl Model {
         for (b, setup) in bodies.iter().enumerate() {
             let mut grid = setup.grid.clone();
             grid.resolve(mode);
-            let g = grid.generate(mode);
+            let mut g = grid.generate(mode);
+            g.sort_along_space_filling_curve();
             let t0 = setup.material.initial_temperature();
             let p_start = particles.len();
             for k in 0..g.particles.len() {
