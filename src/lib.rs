@@ -20,3 +20,4 @@ pub mod output;
 pub mod run;
 pub mod cases;
 pub mod material_point;
+pub mod bench;

@@ -1,0 +1,172 @@
+//! Fixed benchmark workloads (`plugsim bench`): each returns measured
+//! figures; the CLI prints them. Throughput is reported as quadrature-point
+//! updates per second (velocity gradient + stress update + force assembly,
+//! i.e. whole steps) and particle-steps per second, always beside a
+//! baseline measured in the same run (one thread; the alternative force
+//! assembly).
+//!
+//! Deliberately not covered: neighbour search alone (it is part of the
+//! shape-function build), the contact search alone (below 1 % of a step in
+//! the plugging case), output writing (timed in every run's summary).
+
+use crate::case::Case;
+use crate::material::{Constitutive, Material, PointState, StepKinematics};
+use crate::math::{Real, Tensor3, Vec2};
+use crate::run::{build_simulation, RunError};
+use crate::shape::{build_table, AllVisible};
+use crate::step::Simulation;
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// One measured figure.
+#[derive(Clone, Debug)]
+pub struct Figure {
+    pub name: String,
+    pub value: Real,
+    pub unit: &'static str,
+}
+
+fn fig(name: impl Into<String>, value: Real, unit: &'static str) -> Figure {
+    Figure { name: name.into(), value, unit }
+}
+
+/// Run `f` inside a pool of `threads` threads.
+pub fn with_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("thread pool").install(f)
+}
+
+/// Shape-function table build at the quadrature points of a case: rows/s.
+pub fn shape_build(case: &Case, threads: usize) -> Result<Figure, RunError> {
+    let sim = build_simulation(case)?;
+    let m = &sim.model;
+    let t = Instant::now();
+    let table = with_threads(threads, || {
+        build_table(&m.quad.x0, &m.particles.x0, &m.particles.support, &m.particles.volume, &AllVisible)
+    })
+    .map_err(|source| crate::model::ModelError::Shape { body: "bench".into(), source })?;
+    let s = t.elapsed().as_secs_f64();
+    Ok(fig(format!("shape-function build, {threads} thread(s), {} entries", table.nnz()), m.quad.len() as Real / s, "rows/s"))
+}
+
+/// Single-point material updates per second (one thread), in the elastic
+/// regime and in plastic flow, for `material`.
+pub fn material_kernel(material: &Material, n: usize) -> Vec<Figure> {
+    let mut out = Vec::new();
+    for (label, rate) in [("elastic", 1e-3), ("plastic", 1e4)] {
+        let mut d = Tensor3::zeros();
+        d[(0, 1)] = 0.5 * rate;
+        d[(1, 0)] = 0.5 * rate;
+        let k = StepKinematics { d, w: Tensor3::zeros(), dt: 4e-8 };
+        let mut s = PointState::at_rest(material.initial_temperature());
+        // bring the point into the regime first
+        for _ in 0..2000 {
+            s = material.update(&s, &k);
+        }
+        let t = Instant::now();
+        let mut acc = 0.0;
+        for _ in 0..n {
+            let next = material.update(&s, &k);
+            acc += next.tau[(0, 1)];
+            s = if label == "elastic" { PointState { tau: s.tau, ..next } } else { next };
+        }
+        std::hint::black_box(acc);
+        out.push(fig(format!("material update ({label}), 1 thread"), n as Real / t.elapsed().as_secs_f64(), "updates/s"));
+    }
+    out
+}
+
+/// Whole steps on a case's model: quadrature-point updates/s and
+/// particle-steps/s with `threads` threads.
+pub fn steps(case: &Case, threads: usize, n: usize) -> Result<Vec<Figure>, RunError> {
+    with_threads(threads, || {
+        let mut sim = build_simulation(case)?;
+        for _ in 0..5 {
+            sim.step().map_err(unstable)?;
+        }
+        let t = Instant::now();
+        for _ in 0..n {
+            sim.step().map_err(unstable)?;
+        }
+        let s = t.elapsed().as_secs_f64();
+        let (nq, np) = (sim.model.quad.len() as Real, sim.model.particles.len() as Real);
+        Ok(vec![
+            fig(format!("whole steps, {threads} thread(s)"), nq * n as Real / s, "qp-updates/s"),
+            fig(format!("whole steps, {threads} thread(s)"), np * n as Real / s, "particle-steps/s"),
+        ])
+    })
+}
+
+fn unstable(error: crate::step::SolverError) -> RunError {
+    RunError::Unstable { error, last_snapshot: "(none: benchmark)".into(), dir: "(none)".into() }
+}
+
+/// Internal-force assembly: the production gather (each particle sums its
+/// own entries in fixed order) against a scatter into per-thread force
+/// buffers reduced at the end (the usual alternative; not bit-identical
+/// across thread counts). Assemblies/s on the state after a few steps.
+pub fn force_assembly(case: &Case, threads: usize, n: usize) -> Result<Vec<Figure>, RunError> {
+    with_threads(threads, || {
+        let mut sim = build_simulation(case)?;
+        for _ in 0..5 {
+            sim.step().map_err(unstable)?;
+        }
+        let m = &sim.model;
+        let np = m.particles.len();
+        let t = Instant::now();
+        let mut f = vec![Vec2::zeros(); np];
+        for _ in 0..n {
+            gather(&sim, &mut f);
+        }
+        let gather_rate = n as Real / t.elapsed().as_secs_f64();
+        std::hint::black_box(&f);
+        let t = Instant::now();
+        for _ in 0..n {
+            f = scatter(&sim);
+        }
+        let scatter_rate = n as Real / t.elapsed().as_secs_f64();
+        std::hint::black_box(&f);
+        Ok(vec![
+            fig(format!("force assembly: gather (production), {threads} thread(s)"), gather_rate, "assemblies/s"),
+            fig(format!("force assembly: per-thread scatter (alternative), {threads} thread(s)"), scatter_rate, "assemblies/s"),
+        ])
+    })
+}
+
+fn gather(sim: &Simulation, f: &mut [Vec2]) {
+    let m = &sim.model;
+    let (tab, g, pw, xq, mode) = (&m.qp_shape, &m.gather, &m.quad.pw, &m.quad.x0, m.mode);
+    f.par_iter_mut().enumerate().for_each(|(i, fi)| {
+        let mut acc = Vec2::zeros();
+        for j in g.range(i) {
+            let (k, q) = (g.entry[j] as usize, g.point[j] as usize);
+            acc += mode.internal_force(&pw[q], tab.value[k], &tab.grad[k], &xq[q]);
+        }
+        *fi = acc;
+    });
+}
+
+fn scatter(sim: &Simulation) -> Vec<Vec2> {
+    let m = &sim.model;
+    let np = m.particles.len();
+    let (tab, pw, xq, mode) = (&m.qp_shape, &m.quad.pw, &m.quad.x0, m.mode);
+    (0..m.quad.len())
+        .into_par_iter()
+        .fold(
+            || vec![Vec2::zeros(); np],
+            |mut acc, q| {
+                for k in tab.range(q) {
+                    acc[tab.index[k] as usize] += mode.internal_force(&pw[q], tab.value[k], &tab.grad[k], &xq[q]);
+                }
+                acc
+            },
+        )
+        .reduce(
+            || vec![Vec2::zeros(); np],
+            |mut a, b| {
+                for (x, y) in a.iter_mut().zip(b) {
+                    *x += y;
+                }
+                a
+            },
+        )
+}
