@@ -694,6 +694,9 @@ mod tests {
             vec![(1e-20, 1e-20), (2e-20, 1e-20)],
             vec![(1e10, 1.0), (1e10 + 1e-6, 1.0 + 1e-15)],
             vec![(0.0, f64::NAN), (f64::INFINITY, 1.0)],
+            // A range wider than an f64 can hold: hung plotters' tick
+            // generator, then overflowed its pixel mapping, before the
+            // ±AXIS_LIMIT clamp.
             vec![(0.0, -f64::MAX), (1.0, f64::MAX)],
             vec![],
         ];
