@@ -150,7 +150,10 @@ impl HistoryTable {
             }
             for ((field, column), name) in fields.iter().zip(&mut values).zip(&columns) {
                 let value = field.trim().parse::<f64>().map_err(|_| {
-                    parse_error(number, format!("column `{name}`: `{field}` is not a number"))
+                    parse_error(
+                        number,
+                        format!("column `{name}`: `{field}` is not a number"),
+                    )
                 })?;
                 column.push(value);
             }
@@ -191,9 +194,17 @@ mod tests {
         let rows: Vec<[f64; 4]> = (0..50)
             .map(|i| {
                 let t = i as f64 * 2.5e-8;
-                [t, 0.5 * 1e3 * (i as f64).sin().powi(2), -312.7 / (i + 1) as f64, i as f64]
+                [
+                    t,
+                    0.5 * 1e3 * (i as f64).sin().powi(2),
+                    -312.7 / (i + 1) as f64,
+                    i as f64,
+                ]
             })
-            .chain([[1e-300, f64::MAX, -0.0, 0.1 + 0.2], [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 7.0]])
+            .chain([
+                [1e-300, f64::MAX, -0.0, 0.1 + 0.2],
+                [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 7.0],
+            ])
             .collect();
         for row in &rows {
             writer.write_row(row).unwrap();
@@ -244,18 +255,28 @@ mod tests {
         let mut writer = HistoryWriter::create(&path, &["a", "b"]).unwrap();
         assert!(matches!(
             writer.write_row(&[1.0]),
-            Err(IoError::RowLength { expected: 2, found: 1, .. })
+            Err(IoError::RowLength {
+                expected: 2,
+                found: 1,
+                ..
+            })
         ));
         for bad in [["a", "a"], ["a", ""], ["a,b", "c"], [" a", "b"]] {
             assert!(
-                matches!(HistoryWriter::create(&path, &bad), Err(IoError::InvalidName { .. })),
+                matches!(
+                    HistoryWriter::create(&path, &bad),
+                    Err(IoError::InvalidName { .. })
+                ),
                 "{bad:?}"
             );
         }
         let missing = unwritable_path("h.csv");
         let err = HistoryWriter::create(&missing, &["a"]).unwrap_err();
         assert!(matches!(&err, IoError::Write { path: p, .. } if *p == missing));
-        assert!(matches!(HistoryTable::read(&missing), Err(IoError::Read { .. })));
+        assert!(matches!(
+            HistoryTable::read(&missing),
+            Err(IoError::Read { .. })
+        ));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
@@ -274,7 +295,10 @@ mod tests {
             Err(IoError::Parse { line: 2, .. })
         ));
         std::fs::write(&path, "").unwrap();
-        assert!(matches!(HistoryTable::read(&path), Err(IoError::Parse { .. })));
+        assert!(matches!(
+            HistoryTable::read(&path),
+            Err(IoError::Parse { .. })
+        ));
         std::fs::write(&path, " t , x \r\n 0.5 , -1e-3 \r\n").unwrap();
         let table = HistoryTable::read(&path).unwrap();
         assert_eq!(table.column("x").unwrap(), [-1e-3]);

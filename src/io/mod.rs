@@ -254,7 +254,10 @@ pub(crate) mod test_util {
             rest = &rest[end + 1..];
             if tag.starts_with('?') {
                 assert!(tag.ends_with('?'), "bad declaration <{tag}>");
-                assert!(stack.is_empty() && names.is_empty(), "declaration not first");
+                assert!(
+                    stack.is_empty() && names.is_empty(),
+                    "declaration not first"
+                );
                 continue;
             }
             if let Some(name) = tag.strip_prefix('/') {
@@ -269,7 +272,11 @@ pub(crate) mod test_util {
                 .next()
                 .expect("empty tag")
                 .to_string();
-            assert_eq!(tag.matches('"').count() % 2, 0, "unbalanced quotes in <{tag}>");
+            assert_eq!(
+                tag.matches('"').count() % 2,
+                0,
+                "unbalanced quotes in <{tag}>"
+            );
             if stack.is_empty() {
                 roots += 1;
             }
@@ -300,16 +307,35 @@ mod tests {
     #[test]
     fn format_real_round_trips() {
         for v in [
-            0.0, -0.0, 1.0, -2.5, 1e-4, 9.99e-5, 1.25e-5, 1e15, 123456.789, 1e-300, 1e300,
-            f64::MIN_POSITIVE, f64::MAX, 0.1 + 0.2,
+            0.0,
+            -0.0,
+            1.0,
+            -2.5,
+            1e-4,
+            9.99e-5,
+            1.25e-5,
+            1e15,
+            123456.789,
+            1e-300,
+            1e300,
+            f64::MIN_POSITIVE,
+            f64::MAX,
+            0.1 + 0.2,
         ] {
             let text = format_real(v);
-            assert_eq!(text.parse::<f64>().unwrap().to_bits(), v.to_bits(), "{text}");
+            assert_eq!(
+                text.parse::<f64>().unwrap().to_bits(),
+                v.to_bits(),
+                "{text}"
+            );
         }
         assert_eq!(format_real(1.25e-5), "1.25e-5");
         assert_eq!(format_real(0.5), "0.5");
         assert!(format_real(f64::NAN).parse::<f64>().unwrap().is_nan());
-        assert_eq!(format_real(f64::NEG_INFINITY).parse::<f64>().unwrap(), f64::NEG_INFINITY);
+        assert_eq!(
+            format_real(f64::NEG_INFINITY).parse::<f64>().unwrap(),
+            f64::NEG_INFINITY
+        );
     }
 
     #[test]

@@ -217,7 +217,10 @@ const X_LABEL_AREA: u32 = 60;
 const Y_LABEL_AREA: u32 = 100;
 
 fn draw_line_plot(root: &Area, plot: &LinePlot) -> Result<(), String> {
-    let xs = plot.series.iter().flat_map(|s| s.points.iter().map(|p| p.0));
+    let xs = plot
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.0));
     let ys = plot
         .series
         .iter()
@@ -239,8 +242,11 @@ fn draw_line_plot(root: &Area, plot: &LinePlot) -> Result<(), String> {
         .map_err(|e| e.to_string())?;
     let x_ticks = tick_formatter(x0, x1);
     let y_ticks = tick_formatter(y0, y1);
+    let (x_count, y_count) = label_counts(chart.plotting_area().dim_in_pixel());
     chart
         .configure_mesh()
+        .x_labels(x_count)
+        .y_labels(y_count)
         .x_desc(plot.x_label.as_str())
         .y_desc(plot.y_label.as_str())
         .label_style((FONT, 16))
@@ -278,6 +284,7 @@ fn draw_line_plot(root: &Area, plot: &LinePlot) -> Result<(), String> {
         .color(&REFERENCE_LINE)
         .pos(Pos::new(HPos::Right, VPos::Bottom));
     for (label, y) in plot.hlines.iter().filter(|h| h.1.is_finite()) {
+        let y = &y.clamp(-AXIS_LIMIT, AXIS_LIMIT);
         chart
             .draw_series(DashedLineSeries::new(
                 [(x0, *y), (x1, *y)],
@@ -316,7 +323,8 @@ fn draw_field_plot(root: &Area, plot: &FieldPlot) -> Result<(), String> {
     let root = if plot.title.is_empty() {
         root.clone()
     } else {
-        root.titled(&plot.title, (FONT, 28))
+        root.margin(10, 0, 0, 0)
+            .titled(&plot.title, (FONT, 28))
             .map_err(|e| e.to_string())?
     };
     let (width, height) = root.dim_in_pixel();
@@ -332,7 +340,13 @@ fn draw_field_plot(root: &Area, plot: &FieldPlot) -> Result<(), String> {
     let xs = finite_min_max(coords.clone().map(|p| p.0));
     let ys = finite_min_max(coords.map(|p| p.1));
     let plot_px = (
-        f64::from((main.dim_in_pixel().0.saturating_sub(2 * MARGIN + Y_LABEL_AREA)).max(1)),
+        f64::from(
+            (main
+                .dim_in_pixel()
+                .0
+                .saturating_sub(2 * MARGIN + Y_LABEL_AREA))
+            .max(1),
+        ),
         f64::from((height.saturating_sub(2 * MARGIN + X_LABEL_AREA)).max(1)),
     );
     let ((x0, x1), (y0, y1)) = equal_scale_ranges(xs, ys, plot_px);
@@ -345,9 +359,12 @@ fn draw_field_plot(root: &Area, plot: &FieldPlot) -> Result<(), String> {
         .map_err(|e| e.to_string())?;
     let x_ticks = tick_formatter(x0, x1);
     let y_ticks = tick_formatter(y0, y1);
+    let (x_count, y_count) = label_counts(chart.plotting_area().dim_in_pixel());
     chart
         .configure_mesh()
         .disable_mesh()
+        .x_labels(x_count)
+        .y_labels(y_count)
         .x_desc(plot.x_label.as_str())
         .y_desc(plot.y_label.as_str())
         .label_style((FONT, 16))
@@ -380,16 +397,32 @@ fn draw_field_plot(root: &Area, plot: &FieldPlot) -> Result<(), String> {
             .partial_cmp(&(vb.is_finite(), vb))
             .unwrap_or(std::cmp::Ordering::Equal)
     });
-    // Marker radius: about the spacing of the points if they filled the
-    // plot area uniformly, within 1..=8 px.
-    let spacing = (plot_px.0 * plot_px.1 / order.len().max(1) as f64).sqrt();
-    let radius = (0.6 * spacing).round().clamp(1.0, 8.0) as i32;
+    // Marker radius: half the mean point spacing in pixels, estimated from
+    // the points' bounding box (its diagonal for points along a line),
+    // within 1..=8 px.
+    let bbox = finite_min_max(order.iter().map(|&i| plot.points[i].0))
+        .zip(finite_min_max(order.iter().map(|&i| plot.points[i].1)));
+    let radius = bbox.map_or(4.0, |((xa, xb), (ya, yb))| {
+        let (w, h) = (
+            (xb - xa) / (x1 - x0) * plot_px.0,
+            (yb - ya) / (y1 - y0) * plot_px.1,
+        );
+        let n = order.len() as f64;
+        let spacing = if w * h > 0.0 {
+            (w * h / n).sqrt()
+        } else {
+            w.hypot(h) / n
+        };
+        (0.5 * spacing).round().clamp(1.0, 8.0)
+    }) as i32;
     chart
-        .draw_series(
-            order
-                .iter()
-                .map(|&i| Circle::new(plot.points[i], radius, colour(plot.values[i]).filled())),
-        )
+        .draw_series(order.iter().map(|&i| {
+            Circle::new(
+                clip(plot.points[i]),
+                radius,
+                colour(plot.values[i]).filled(),
+            )
+        }))
         .map_err(|e| e.to_string())?;
     for line in &plot.lines {
         for run in finite_runs(line) {
@@ -414,6 +447,7 @@ fn draw_field_plot(root: &Area, plot: &FieldPlot) -> Result<(), String> {
         .configure_mesh()
         .disable_mesh()
         .disable_x_axis()
+        .set_tick_mark_size(LabelAreaPosition::Right, 6)
         .y_desc(plot.value_label.as_str())
         .label_style((FONT, 16))
         .axis_desc_style((FONT, 20))
@@ -434,10 +468,26 @@ fn draw_field_plot(root: &Area, plot: &FieldPlot) -> Result<(), String> {
     Ok(())
 }
 
-/// Minimum and maximum of the finite values, `None` if there are none.
+/// Maximum numbers of tick labels on the x and y axes of a plot area of
+/// `pixels` (width, height), so that labels do not overlap.
+fn label_counts(pixels: (u32, u32)) -> (usize, usize) {
+    (
+        (pixels.0 / 90).clamp(2, 10) as usize,
+        (pixels.1 / 50).clamp(2, 10) as usize,
+    )
+}
+
+/// Largest magnitude an axis range reaches: plotters' tick generator loops
+/// forever on a range whose width overflows to infinity, so data beyond
+/// ±1e300 are clipped at the edge of the plot.
+const AXIS_LIMIT: f64 = 1e300;
+
+/// Minimum and maximum of the finite values, clamped to ±[`AXIS_LIMIT`];
+/// `None` if there are no finite values.
 fn finite_min_max(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
     values
         .filter(|v| v.is_finite())
+        .map(|v| v.clamp(-AXIS_LIMIT, AXIS_LIMIT))
         .fold(None, |acc, v| match acc {
             None => Some((v, v)),
             Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
@@ -480,7 +530,9 @@ fn equal_scale_ranges(
         return ((0.0, 1.0), (0.0, 1.0));
     };
     let span = (xs.1 - xs.0).max(ys.1 - ys.0);
-    let magnitude = [xs.0, xs.1, ys.0, ys.1].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let magnitude = [xs.0, xs.1, ys.0, ys.1]
+        .iter()
+        .fold(0.0f64, |m, v| m.max(v.abs()));
     let pad = if span > 1e-12 * magnitude {
         0.05 * span
     } else if magnitude > 0.0 {
@@ -493,19 +545,32 @@ fn equal_scale_ranges(
     let scale = ((x1 - x0) / pixels.0).max((y1 - y0) / pixels.1);
     let (xc, yc) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
     let (hx, hy) = (0.5 * scale * pixels.0, 0.5 * scale * pixels.1);
-    if [xc - hx, xc + hx, yc - hy, yc + hy].iter().all(|v| v.is_finite()) {
+    if [xc - hx, xc + hx, yc - hy, yc + hy]
+        .iter()
+        .all(|v| v.is_finite())
+    {
         ((xc - hx, xc + hx), (yc - hy, yc + hy))
     } else {
         ((x0, x1), (y0, y1))
     }
 }
 
-/// Splits `points` into runs of consecutive finite points.
+/// `point` with both coordinates clamped to ±[`AXIS_LIMIT`], so it lies
+/// inside the automatic ranges (plotters' pixel mapping overflows on points
+/// far outside the range).
+fn clip(point: (f64, f64)) -> (f64, f64) {
+    (
+        point.0.clamp(-AXIS_LIMIT, AXIS_LIMIT),
+        point.1.clamp(-AXIS_LIMIT, AXIS_LIMIT),
+    )
+}
+
+/// Splits `points` into runs of consecutive finite points, [`clip`]ped.
 fn finite_runs(points: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
     points
         .split(|p| !(p.0.is_finite() && p.1.is_finite()))
         .filter(|run| !run.is_empty())
-        .map(<[_]>::to_vec)
+        .map(|run| run.iter().copied().map(clip).collect())
         .collect()
 }
 
@@ -629,6 +694,9 @@ mod tests {
             vec![(1e-20, 1e-20), (2e-20, 1e-20)],
             vec![(1e10, 1.0), (1e10 + 1e-6, 1.0 + 1e-15)],
             vec![(0.0, f64::NAN), (f64::INFINITY, 1.0)],
+            // A range wider than an f64 can hold: hung plotters' tick
+            // generator, then overflowed its pixel mapping, before the
+            // ±AXIS_LIMIT clamp.
             vec![(0.0, -f64::MAX), (1.0, f64::MAX)],
             vec![],
         ];
@@ -711,6 +779,10 @@ mod tests {
             (vec![(0.0, 0.0)], vec![3.0]),
             (vec![(0.0, 0.0), (1.0, 0.0)], vec![2.0, 2.0]),
             (vec![(1.0, 1.0), (1.0, 1.0)], vec![f64::NAN, f64::INFINITY]),
+            (
+                vec![(-f64::MAX, 0.0), (f64::MAX, f64::MAX), (0.0, f64::NAN)],
+                vec![-f64::MAX, f64::MAX, 0.0],
+            ),
         ];
         for (i, (points, values)) in degenerate.into_iter().enumerate() {
             let plot = FieldPlot {

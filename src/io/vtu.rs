@@ -256,13 +256,31 @@ pub fn write_vtu(path: &Path, piece: &VtuPiece) -> Result<(), IoError> {
         (Section::CellData, &piece.cell_data),
     ] {
         blocks.extend(arrays.iter().map(|a| {
-            block(section, a.data.vtk_type(), &a.name, a.components, a.data.bytes())
+            block(
+                section,
+                a.data.vtk_type(),
+                &a.name,
+                a.components,
+                a.data.bytes(),
+            )
         }));
     }
     let point_bytes = bytemuck::cast_slice(&piece.points);
     blocks.push(block(Section::Points, "Float64", "Points", 3, point_bytes));
-    blocks.push(block(Section::Cells, "Int64", "connectivity", 1, bytemuck::cast_slice(&connectivity)));
-    blocks.push(block(Section::Cells, "Int64", "offsets", 1, bytemuck::cast_slice(&offsets)));
+    blocks.push(block(
+        Section::Cells,
+        "Int64",
+        "connectivity",
+        1,
+        bytemuck::cast_slice(&connectivity),
+    ));
+    blocks.push(block(
+        Section::Cells,
+        "Int64",
+        "offsets",
+        1,
+        bytemuck::cast_slice(&offsets),
+    ));
     blocks.push(block(Section::Cells, "UInt8", "types", 1, &types));
     let mut offset = 0;
     for block in &mut blocks {
@@ -436,11 +454,20 @@ mod tests {
         let data = &bytes[underscore + 1..];
         let header = String::from_utf8(bytes[..start + marker.len()].to_vec()).unwrap();
         let tail = b"\n  </AppendedData>\n</VTKFile>\n";
-        assert!(bytes.ends_with(tail), "file does not end with the closing tags");
+        assert!(
+            bytes.ends_with(tail),
+            "file does not end with the closing tags"
+        );
 
         let piece_tag = &header[header.find("<Piece ").unwrap()..];
-        let n_points = attribute(piece_tag, "NumberOfPoints").unwrap().parse().unwrap();
-        let n_cells = attribute(piece_tag, "NumberOfCells").unwrap().parse().unwrap();
+        let n_points = attribute(piece_tag, "NumberOfPoints")
+            .unwrap()
+            .parse()
+            .unwrap();
+        let n_cells = attribute(piece_tag, "NumberOfCells")
+            .unwrap()
+            .parse()
+            .unwrap();
 
         let mut arrays = Vec::new();
         let mut section = String::new();
@@ -538,11 +565,20 @@ mod tests {
         assert_eq!(vtu.get("Points", "Points").components, 3);
         assert_bits_eq(&vtu.get("PointData", "pressure").f64s(), &pressure);
         assert_eq!(vtu.get("PointData", "pressure").components, 1);
-        assert_bits_eq(&vtu.get("PointData", "velocity").f64s(), velocity.as_flattened());
+        assert_bits_eq(
+            &vtu.get("PointData", "velocity").f64s(),
+            velocity.as_flattened(),
+        );
         assert_eq!(vtu.get("PointData", "velocity").components, 3);
-        assert_bits_eq(&vtu.get("PointData", "stress").f64s(), stress.as_flattened());
+        assert_bits_eq(
+            &vtu.get("PointData", "stress").f64s(),
+            stress.as_flattened(),
+        );
         assert_eq!(vtu.get("PointData", "stress").components, 6);
-        assert_bits_eq(&vtu.get("PointData", "F").f64s(), deformation.as_flattened());
+        assert_bits_eq(
+            &vtu.get("PointData", "F").f64s(),
+            deformation.as_flattened(),
+        );
         assert_eq!(vtu.get("PointData", "F").components, 9);
         assert_eq!(vtu.get("PointData", "material").i32s(), material);
         assert_eq!(vtu.get("CellData", "flags").i32s(), flags);
@@ -653,13 +689,21 @@ mod tests {
         let short = cloud().with_point_data(DataArray::scalars("p", vec![0.0; 3]));
         assert!(matches!(
             write_vtu(&path, &short),
-            Err(IoError::ArrayLength { expected: 4, found: 3, .. })
+            Err(IoError::ArrayLength {
+                expected: 4,
+                found: 3,
+                ..
+            })
         ));
         let cell_short = VtuPiece::poly_lines(vec![[0.0; 3]; 4], vec![vec![0, 1], vec![2, 3]])
             .with_cell_data(DataArray::scalars("c", vec![0.0; 4]));
         assert!(matches!(
             write_vtu(&path, &cell_short),
-            Err(IoError::ArrayLength { expected: 2, found: 4, .. })
+            Err(IoError::ArrayLength {
+                expected: 2,
+                found: 4,
+                ..
+            })
         ));
         let zero = cloud().with_point_data(DataArray {
             name: "z".into(),
@@ -685,7 +729,12 @@ mod tests {
         let out_of_range = VtuPiece::poly_lines(vec![[0.0; 3]; 2], vec![vec![0, 1], vec![1, 2]]);
         assert!(matches!(
             write_vtu(&path, &out_of_range),
-            Err(IoError::CellIndex { cell: 1, index: 2, points: 2, .. })
+            Err(IoError::CellIndex {
+                cell: 1,
+                index: 2,
+                points: 2,
+                ..
+            })
         ));
         let empty = VtuPiece::poly_lines(vec![[0.0; 3]; 2], vec![vec![]]);
         assert!(matches!(
