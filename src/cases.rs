@@ -13,6 +13,11 @@ pub const BUILTIN_CASES: &[(&str, &str, &str)] = &[
         include_str!("../cases/elastic-disc-axisym.toml"),
         "elastic steel disc, struck centre, axisymmetric (seconds)",
     ),
+    (
+        "borvik-1-nofracture",
+        include_str!("../cases/borvik-1-nofracture.toml"),
+        "Borvik Case I (298 m/s, 11.1 mm Weldox), plane strain, coarse, no fracture",
+    ),
 ];
 
 /// The text of the built-in case `name`.

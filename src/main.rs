@@ -50,6 +50,23 @@ enum Command {
     },
     /// List the built-in cases.
     Cases,
+    /// Benchmark fixed workloads: shape functions, material kernel, force
+    /// assembly, whole steps (1 and all threads), optionally whole cases.
+    Bench {
+        /// Built-in case used for the step workloads.
+        #[arg(long, default_value = "borvik-1-nofracture")]
+        case: String,
+        /// Steps per whole-step measurement.
+        #[arg(long, default_value_t = 50)]
+        steps: usize,
+        /// Also run the whole case to this end time, s, with output every 1 us
+        /// (e.g. 118e-6 for the paper's Case I), with 1 and all threads.
+        #[arg(long)]
+        whole: Option<f64>,
+        /// Extra `--set` overrides for the case (e.g. a fine discretization).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+    },
     /// Drive one material point through a deformation history and write
     /// stress-strain-temperature-damage curves (CSV + PNG): the calibration tool.
     MaterialPoint {
@@ -130,6 +147,7 @@ fn dispatch(cmd: Command) -> Result<()> {
             }
             Ok(())
         }
+        Command::Bench { case, steps, whole, set } => bench(&case, steps, whole, &set),
         Command::MaterialPoint { material, case_file, path, rate, strain, dt, out } => {
             material_point(&material, case_file.as_deref(), path, rate, strain, dt, &out)
         }
@@ -174,6 +192,67 @@ fn material_point(name: &str, case_file: Option<&Path>, path: PathArg, rate: f64
     println!("  wrote {}", csv.display());
     for p in plots {
         println!("  wrote {}", p.display());
+    }
+    Ok(())
+}
+
+fn bench(name: &str, steps: usize, whole: Option<f64>, set: &[String]) -> Result<()> {
+    use plugsim::bench;
+    let text = builtin_case(name).with_context(|| format!("unknown built-in case '{name}'"))?;
+    let case = Case::from_str_with(text, name, set)?.resolved();
+    let all = rayon::current_num_threads();
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| s.lines().find(|l| l.starts_with("model name")).map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string()))
+        .unwrap_or_else(|| "unknown CPU".into());
+    println!("plugsim bench {} ({}) on {cpu}, {all} threads available", env!("CARGO_PKG_VERSION"), env!("PLUGSIM_COMMIT"));
+    println!("case {name}: {}", case.title);
+    let show = |f: &bench::Figure| println!("  {:70} {:>12.4e} {}", f.name, f.value, f.unit);
+    let material = plugsim::material::builtin("weldox_460e").context("built-in material")?;
+    for f in bench::material_kernel(&material, 200_000) {
+        show(&f);
+    }
+    for threads in [1, all] {
+        show(&bench::shape_build(&case, threads)?);
+    }
+    for threads in [1, all] {
+        for f in bench::force_assembly(&case, threads, 20)? {
+            show(&f);
+        }
+    }
+    let mut rates = Vec::new();
+    for threads in [1, all] {
+        let f = bench::steps(&case, threads, steps)?;
+        rates.push(f[0].value);
+        for x in &f {
+            show(x);
+        }
+    }
+    println!("  speed-up 1 -> {all} threads (whole steps): {:.2}x", rates[1] / rates[0]);
+    if let Some(end) = whole {
+        let mut walls = Vec::new();
+        for threads in [1, all] {
+            let dir = std::env::temp_dir().join(format!("plugsim-bench-{}-{threads}", std::process::id()));
+            let mut c = case.clone();
+            c.time.end = end;
+            c.output.interval = Some(1e-6);
+            let cfg = RunConfig { out_dir: dir.clone(), force: true, info: RunInfo::current(name, set) };
+            let t = Instant::now();
+            let s = bench::with_threads(threads, || execute(&c, &cfg, &mut |_| {}))?;
+            let wall = t.elapsed().as_secs_f64();
+            walls.push(wall);
+            let _ = std::fs::remove_dir_all(&dir);
+            println!(
+                "  whole case to {:.1} us, {threads} thread(s): {wall:.2} s wall ({} steps, {} particles, {} qps, {} snapshots; {:.3e} qp-updates/s)",
+                end * 1e6,
+                s.steps,
+                s.particles,
+                s.quadrature_points,
+                s.snapshots,
+                s.quadrature_points as f64 * s.steps as f64 / s.loop_wall.as_secs_f64()
+            );
+        }
+        println!("  whole-case speed-up 1 -> {all} threads: {:.2}x", walls[0] / walls[1]);
     }
     Ok(())
 }
