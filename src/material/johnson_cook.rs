@@ -109,6 +109,18 @@
 //! not capped at 1: `D ≥ 1` means failed. The heating and the thermal
 //! expansion term use the start-of-step `τ̄`, as SPEC §6 writes (except in
 //! the fallback of Deviation 5).
+//! 12. **Negligible flow.** Before any flow update, the viscoplastic rate
+//!     is evaluated at the elastic trial stress of the step; it bounds the
+//!     step's rate from above (the rate grows with `τ̄`, and flow only relaxes
+//!     the trial). If that bound would relax the trial stress by less than
+//!     [`NEGLIGIBLE_RELAXATION`] of itself (`3GΔt ε̄̇(τ̄_tr) ≤ 1e-8 τ̄_tr`,
+//!     with `τ̄_tr` floored at [`NEGLIGIBLE_STRESS_RATIO`]` · g`), the
+//!     step is elastic to that tolerance: the trial stress is kept and the
+//!     bound's tiny plastic strain, heat and damage are booked. For Weldox
+//!     at `Δt = 4·10⁻⁸ s` this covers every point below ~91 % of `g`, which
+//!     would otherwise often take the (iterative, costly) radial return of
+//!     Deviation 11 while the stress is still small. Test:
+//!     `negligible_flow_fast_path_agrees_with_the_full_update`.
 
 use super::{jaumann_update, Constitutive, PointState, StepKinematics, ThermalProperties};
 use crate::math::{ddot, deviator, identity, mean_stress, von_mises, Real, Tensor3};
@@ -131,6 +143,16 @@ pub const MAX_RATE_EXPONENT: Real = 50.0;
 /// treated as strengthless (Deviation 4). 1e-9 G ≈ 80 Pa for steel; keeps
 /// `∂ε̄̇/∂τ̄ ∝ 1/g` finite.
 pub const MIN_FLOW_STRESS_RATIO: Real = 1e-9;
+
+/// Largest relative relaxation of the elastic trial stress that a step may
+/// neglect (Deviation 12): far below the 1 % accuracy the driver tests ask
+/// and below the round-off growth of an explicit run.
+pub const NEGLIGIBLE_RELAXATION: Real = 1e-8;
+
+/// Stress scale below which relaxation is measured against `1e-6 g`
+/// rather than `τ̄` itself (Deviation 12): the neglected stress change is
+/// then at most `1e-14 g`, about 5 µPa for Weldox.
+pub const NEGLIGIBLE_STRESS_RATIO: Real = 1e-6;
 
 /// Floor on the Johnson–Cook failure strain (Deviation 9).
 pub const MIN_FAILURE_STRAIN: Real = 1e-6;
@@ -639,10 +661,40 @@ impl JohnsonCook {
         if dt <= 0.0 {
             return *old;
         }
+        if let Some(elastic_step) = self.negligible_flow_step(old, d, w, dt, fs) {
+            return elastic_step;
+        }
         if self.elastic_increment(d, dt) > von_mises(&old.tau) {
             return self.radial_return(old, &self.elastic_stress_rate(d), w, dt, fs);
         }
         self.update_tangent(old, d, w, dt, fs, pr)
+    }
+
+    /// Deviation 12: the elastic trial step when flow cannot matter, else `None`.
+    fn negligible_flow_step(&self, old: &PointState, d: &Tensor3, w: &Tensor3, dt: Real, fs: &FlowStress) -> Option<PointState> {
+        let trial = jaumann_update(&old.tau, &self.elastic_stress_rate(d), w, dt);
+        let tau_bar = von_mises(&trial);
+        let rate = self.plastic_rate(tau_bar, fs.g).rate;
+        // Absolute floor: the log law creeps at ε̇₀ e^{−1/C} > 0 even at zero
+        // stress, so round-off-sized stresses (seen ahead of wave fronts)
+        // would otherwise never pass a purely relative test.
+        let scale = tau_bar.max(NEGLIGIBLE_STRESS_RATIO * fs.g);
+        if !(3.0 * self.shear_modulus() * dt * rate <= NEGLIGIBLE_RELAXATION * scale) {
+            return None;
+        }
+        let damage = if rate > 0.0 && tau_bar > 0.0 {
+            let eps_f = self.failure_strain(mean_stress(&trial) / tau_bar, rate, old.temperature);
+            old.damage + dt * rate / eps_f
+        } else {
+            old.damage
+        };
+        Some(PointState {
+            tau: trial,
+            eps_p: old.eps_p + dt * rate,
+            eps_p_rate: rate,
+            temperature: old.temperature + dt * self.heating_coefficient() * tau_bar * rate,
+            damage,
+        })
     }
 
     /// The tangent-modulus update of SPEC §6 over `dt` from `old`, with the
@@ -713,8 +765,8 @@ impl JohnsonCook {
     /// Deviation 5): from the elastic predictor `τ_tr`, find `τ̄_e` with
     /// `Δε̄ = (τ̄_tr − τ̄_e)/(3G) = Δt φ(τ̄_e, g(ε̄ + Δε̄))` (hardening implicit,
     /// temperature and damage frozen at the start of the step; the left side
-    /// falls and the right rises with `τ̄_e`, so the root is unique and
-    /// bisection finds it), scale the predictor's deviator by
+    /// falls and the right rises with `τ̄_e`, so the root is unique and a
+    /// safeguarded Newton iteration finds it), scale the predictor's deviator by
     /// `τ̄_e/τ̄_tr`, heat by `χ (τ̄ + τ̄_e)/2 Δε̄/(ρ₀C_p)`, take the thermal
     /// pressure `3Kα ΔT` off the mean stress, and accumulate damage with the
     /// end-of-step triaxiality. SPEC §6 (flow rule, heating,
@@ -738,26 +790,50 @@ impl JohnsonCook {
                 ..*old
             };
         }
+        // r(τ̄_e) = Δt φ(τ̄_e, g(ε̄ + Δε̄)) − Δε̄ rises monotonically from r(0) < 0
+        // to r(τ̄_tr) ≥ 0. Safeguarded Newton: a Newton step from the
+        // bracket's current end, bisection whenever it would leave the
+        // bracket or stall. Derivative: dr/dτ̄_e = Δt (f_τ + f_τ τ̄_e g_ε /
+        // (3G g)) + 1/(3G), using ∂φ/∂g = −f_τ τ̄_e/g (both rate laws).
         let residual = |tau_e: Real| {
             let d_eps = (tau_trial - tau_e) / three_g;
-            let g = self
-                .flow_stress(old.eps_p + d_eps, old.temperature, old.damage)
-                .max(fs.g);
-            dt * self.plastic_rate(tau_e, g).rate - d_eps
+            let slopes = self.flow_stress_slopes(old.eps_p + d_eps, old.temperature, old.damage);
+            let g = slopes.g.max(fs.g);
+            let pr = self.plastic_rate(tau_e, g);
+            let r = dt * pr.rate - d_eps;
+            let dr = dt * pr.d_rate_d_tau * (1.0 + tau_e * slopes.g_eps / (three_g * g)) + 1.0 / three_g;
+            (r, dr)
         };
+        // rtsafe-style: Newton while it stays inside the bracket and halves
+        // the step at least as fast as bisection would, bisection otherwise.
         let (mut lo, mut hi) = (0.0, tau_trial);
+        let mut x = tau_trial;
+        let (mut dx, mut dx_old) = (tau_trial, tau_trial);
         for _ in 0..200 {
-            let mid = 0.5 * (lo + hi);
-            if residual(mid) > 0.0 {
-                hi = mid;
-            } else {
-                lo = mid;
+            let (r, dr) = residual(x);
+            if r == 0.0 {
+                break;
             }
-            if hi - lo <= 4.0 * Real::EPSILON * hi {
+            if r > 0.0 {
+                hi = x;
+            } else {
+                lo = x;
+            }
+            let leaves = ((x - hi) * dr - r) * ((x - lo) * dr - r) > 0.0;
+            if leaves || !dr.is_finite() || (2.0 * r).abs() > (dx_old * dr).abs() {
+                dx_old = dx;
+                dx = 0.5 * (hi - lo);
+                x = lo + dx;
+            } else {
+                dx_old = dx;
+                dx = r / dr;
+                x -= dx;
+            }
+            if dx.abs() <= 2.0 * Real::EPSILON * tau_trial || hi - lo <= 4.0 * Real::EPSILON * hi {
                 break;
             }
         }
-        let tau_end = 0.5 * (lo + hi);
+        let tau_end = x.clamp(lo, hi);
         let d_eps = (tau_trial - tau_end) / three_g;
         let tau_bar = von_mises(&old.tau);
         let d_temp = self.heating_coefficient() * 0.5 * (tau_bar + tau_end) * d_eps;
@@ -1198,9 +1274,17 @@ mod tests {
         let xi = 0.5 * dt * pr.d_rate_d_tau * m.tangent_modulus(1.1 * g, &fs);
         assert!((pr.rate + 0.5 * dt * pr.d_rate_d_tau * p_d) / (1.0 + xi) < 0.0);
         let new = m.update(&old, &kin(d, Tensor3::zeros(), dt));
-        assert_eq!(new.eps_p, old.eps_p);
-        assert_eq!(new.eps_p_rate, 0.0);
-        assert_eq!((new.temperature, new.damage), (old.temperature, old.damage));
+        // The unloaded trial lies far below g, so the step is elastic
+        // (Deviation 12): at most the log law's vanishing rate is booked.
+        assert!(new.eps_p >= old.eps_p && new.eps_p - old.eps_p < 1e-12);
+        assert!(new.eps_p_rate >= 0.0 && new.eps_p_rate < 1e-3);
+        assert!(new.temperature >= old.temperature && new.temperature - old.temperature < 1e-6);
+        assert!(new.damage >= old.damage && new.damage - old.damage < 1e-10);
+        // and with the fast path bypassed the tangent clamp gives exactly zero
+        let pr_old = m.plastic_rate(1.1 * g, g);
+        let t = m.update_tangent(&old, &d, &Tensor3::zeros(), dt, &fs, &pr_old);
+        assert_eq!(t.eps_p, old.eps_p);
+        assert_eq!(t.eps_p_rate, 0.0);
     }
 
     #[test]
@@ -1223,6 +1307,33 @@ mod tests {
     /// Regression: the radial return from a zero deviator took the
     /// start-of-step triaxiality 0/0 = NaN, which the failure-strain floor
     /// turned into ε_f = 1e-6, i.e. D ≈ 300 after the first step.
+    #[test]
+    fn negligible_flow_fast_path_agrees_with_the_full_update() {
+        // A point at 40 % of its flow stress loaded by a step whose elastic
+        // increment exceeds its stress: without the fast path this step takes
+        // the radial return (Deviation 11). Both must agree to the tolerance.
+        let m = weldox_460e();
+        let mut old = PointState::at_rest(m.room_temperature);
+        old.tau[(0, 1)] = 0.4 * m.yield_stress / 3f64.sqrt();
+        old.tau[(1, 0)] = old.tau[(0, 1)];
+        let mut d = Tensor3::zeros();
+        d[(0, 1)] = 2e4;
+        d[(1, 0)] = 2e4;
+        let dt = 4e-8;
+        let k = kin(d, Tensor3::zeros(), dt);
+        assert!(m.elastic_increment(&d, dt) > von_mises(&old.tau));
+        let fs = m.flow_stress_slopes(old.eps_p, old.temperature, old.damage);
+        let fast = m.negligible_flow_step(&old, &d, &k.w, dt, &fs).expect("fast path applies");
+        let full = m.radial_return(&old, &m.elastic_stress_rate(&d), &k.w, dt, &fs);
+        let rel = (fast.tau - full.tau).norm() / full.tau.norm();
+        assert!(rel < 1e-7, "relative stress difference {rel:e}");
+        assert!(fast.eps_p >= old.eps_p && fast.eps_p - old.eps_p < 1e-12);
+        // near the flow stress the fast path must step aside
+        let mut near = old;
+        near.tau *= 0.98 / 0.4;
+        assert!(m.negligible_flow_step(&near, &d, &k.w, dt, &fs).is_none());
+    }
+
     #[test]
     fn radial_return_from_rest_accumulates_ordinary_damage() {
         let m = weldox_460e();
