@@ -682,7 +682,9 @@ impl JohnsonCook {
         if !(3.0 * self.shear_modulus() * dt * rate <= NEGLIGIBLE_RELAXATION * scale) {
             return None;
         }
-        let damage = if rate > 0.0 && tau_bar > 0.0 {
+        // No deviator, no flow direction: nothing to book.
+        let rate = if tau_bar > 0.0 { rate } else { 0.0 };
+        let damage = if rate > 0.0 {
             let eps_f = self.failure_strain(mean_stress(&trial) / tau_bar, rate, old.temperature);
             old.damage + dt * rate / eps_f
         } else {
@@ -1304,9 +1306,6 @@ mod tests {
         assert_eq!(p.tau, identity() * (m.bulk_modulus() * 3e3 * 1e-7));
     }
 
-    /// Regression: the radial return from a zero deviator took the
-    /// start-of-step triaxiality 0/0 = NaN, which the failure-strain floor
-    /// turned into ε_f = 1e-6, i.e. D ≈ 300 after the first step.
     #[test]
     fn negligible_flow_fast_path_agrees_with_the_full_update() {
         // A point at 40 % of its flow stress loaded by a step whose elastic
@@ -1334,6 +1333,9 @@ mod tests {
         assert!(m.negligible_flow_step(&near, &d, &k.w, dt, &fs).is_none());
     }
 
+    /// Regression: the radial return from a zero deviator took the
+    /// start-of-step triaxiality 0/0 = NaN, which the failure-strain floor
+    /// turned into ε_f = 1e-6, i.e. D ≈ 300 after the first step.
     #[test]
     fn radial_return_from_rest_accumulates_ordinary_damage() {
         let m = weldox_460e();
