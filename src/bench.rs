@@ -134,12 +134,12 @@ pub fn force_assembly(case: &Case, threads: usize, n: usize) -> Result<Vec<Figur
 
 fn gather(sim: &Simulation, f: &mut [Vec2]) {
     let m = &sim.model;
-    let (tab, g, pw, xq, mode) = (&m.qp_shape, &m.gather, &m.quad.pw, &m.quad.x0, m.mode);
+    let (g, pw, xq, mode) = (&m.gather, &m.quad.pw, &m.quad.x0, m.mode);
     f.par_iter_mut().enumerate().for_each(|(i, fi)| {
         let mut acc = Vec2::zeros();
         for j in g.range(i) {
-            let (k, q) = (g.entry[j] as usize, g.point[j] as usize);
-            acc += mode.internal_force(&pw[q], tab.value[k], &tab.grad[k], &xq[q]);
+            let q = g.point[j] as usize;
+            acc += mode.internal_force(&pw[q], g.value[j], &g.grad[j], &xq[q]);
         }
         *fi = acc;
     });

@@ -96,6 +96,11 @@ pub struct Gather {
     pub entry: Vec<u32>,
     /// Quadrature point (row) of that entry.
     pub point: Vec<u32>,
+    /// `N_I(X_q)` of that entry, copied in gather order so the force sweep
+    /// streams through memory.
+    pub value: Vec<Real>,
+    /// `∇N_I(X_q)` of that entry, in gather order.
+    pub grad: Vec<Vec2>,
 }
 
 impl Gather {
@@ -111,15 +116,19 @@ impl Gather {
         let mut fill = offsets.clone();
         let mut entry = vec![0u32; table.nnz()];
         let mut point = vec![0u32; table.nnz()];
+        let mut value = vec![0.0; table.nnz()];
+        let mut grad = vec![Vec2::zeros(); table.nnz()];
         for q in 0..table.rows() {
             for k in table.range(q) {
                 let i = table.index[k] as usize;
                 entry[fill[i]] = k as u32;
                 point[fill[i]] = q as u32;
+                value[fill[i]] = table.value[k];
+                grad[fill[i]] = table.grad[k];
                 fill[i] += 1;
             }
         }
-        Gather { offsets, entry, point }
+        Gather { offsets, entry, point, value, grad }
     }
     #[inline]
     pub fn range(&self, i: usize) -> std::ops::Range<usize> {

@@ -364,12 +364,12 @@ impl Simulation {
     /// `f_int,I = Σ_q (P w)_q ∇N_I(X_q)` (+ hoop term), gathered per particle.
     fn internal_force(&mut self) {
         let m = &mut self.model;
-        let (tab, gather, pw, xq, mode) = (&m.qp_shape, &m.gather, &m.quad.pw, &m.quad.x0, m.mode);
+        let (gather, pw, xq, mode) = (&m.gather, &m.quad.pw, &m.quad.x0, m.mode);
         m.particles.f_int.par_iter_mut().enumerate().for_each(|(i, f)| {
             let mut acc = Vec2::zeros();
             for j in gather.range(i) {
-                let (k, q) = (gather.entry[j] as usize, gather.point[j] as usize);
-                acc += mode.internal_force(&pw[q], tab.value[k], &tab.grad[k], &xq[q]);
+                let q = gather.point[j] as usize;
+                acc += mode.internal_force(&pw[q], gather.value[j], &gather.grad[j], &xq[q]);
             }
             *f = acc;
         });
