@@ -8,7 +8,7 @@
 use crate::contact::{mass_axisymmetric, mass_plane_strain, rectangle_outline, ContactError, RigidBody};
 use crate::discretize::RectangleGrid;
 use crate::geometry::GeometryMode;
-use crate::material::{Elastic, JohnsonCook, Material, ThermalProperties};
+use crate::material::{Constitutive, Elastic, JohnsonCook, Material, ThermalProperties};
 use crate::math::{Real, Vec2};
 use crate::model::{BodySetup, Region, Support};
 use crate::step::TimeStepRule;
@@ -37,6 +37,9 @@ pub struct Case {
     /// Contact with the rigid bodies (SPEC §8).
     #[serde(default)]
     pub contact: crate::contact::ContactParameters,
+    /// Heat conduction (SPEC §7).
+    #[serde(default)]
+    pub heat: HeatSpec,
     /// Time integration.
     pub time: TimeSpec,
     /// Output.
@@ -156,6 +159,40 @@ pub struct RigidRectangle {
     pub width: Real,
     /// Extent along y, m.
     pub height: Real,
+}
+
+/// `[heat]`: heat conduction between particles after the adiabatic material
+/// update (SPEC §7, [`crate::thermal`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HeatSpec {
+    /// Conduct heat (`true`) or keep every step adiabatic (`false`).
+    /// Default: on when every deformable body's material has thermal
+    /// properties (Johnson–Cook always has; an elastic material needs both
+    /// `specific_heat` and `thermal_conductivity`), off otherwise. SPEC §7
+    /// makes conduction part of every step, so a material that can conduct
+    /// does; a case with a body that cannot is adiabatic unless it asks for
+    /// conduction, and then it is an error rather than a silent partial
+    /// switch. The resolved case records the value used.
+    #[serde(default)]
+    pub conduction: Option<bool>,
+    /// Safety factor `s` of the conduction sub-step `Δt_th = s · 2/λ̂`, where
+    /// `λ̂` is a guaranteed bound on the conduction operator's largest
+    /// eigenvalue; in (0, 1]. Default 0.5
+    /// ([`crate::thermal::DEFAULT_SAFETY_FACTOR`]: every mode decays without
+    /// oscillating). The mechanical step is sub-cycled when it is longer.
+    #[serde(default = "heat_safety")]
+    pub safety_factor: Real,
+}
+
+fn heat_safety() -> Real {
+    crate::thermal::DEFAULT_SAFETY_FACTOR
+}
+
+impl Default for HeatSpec {
+    fn default() -> Self {
+        HeatSpec { conduction: None, safety_factor: heat_safety() }
+    }
 }
 
 /// `[time]`
@@ -407,6 +444,23 @@ impl Case {
         if !(self.contact.tolerance.is_finite() && self.contact.tolerance > 0.0) {
             add("contact.tolerance".into(), format!("must be > 0, got {}", self.contact.tolerance));
         }
+        if !(self.heat.safety_factor > 0.0 && self.heat.safety_factor <= 1.0) {
+            add("heat.safety_factor".into(), format!("must lie in (0, 1], got {}", self.heat.safety_factor));
+        }
+        if self.heat.conduction == Some(true) {
+            for b in &self.bodies {
+                if self.material(&b.material).is_some_and(|m| m.thermal().is_none()) {
+                    add(
+                        "heat.conduction".into(),
+                        format!(
+                            "is true, but body '{}' has material '{}' without thermal properties \
+                             (give it specific_heat and thermal_conductivity, or set heat.conduction = false)",
+                            b.name, b.material
+                        ),
+                    );
+                }
+            }
+        }
         positive(&mut add, "time.end", self.time.end, "s");
         if !(self.time.safety_factor > 0.0 && self.time.safety_factor <= 1.0) {
             add("time.safety_factor".into(), format!("must lie in (0, 1], got {}", self.time.safety_factor));
@@ -448,7 +502,16 @@ impl Case {
         if c.output.interval.is_none() {
             c.output.interval = Some(c.time.end / 50.0);
         }
+        c.heat.conduction = Some(self.heat_conduction());
         c
+    }
+
+    /// Whether the run conducts heat: `heat.conduction`, or by default
+    /// whether every body's material has thermal properties (see [`HeatSpec`]).
+    pub fn heat_conduction(&self) -> bool {
+        self.heat.conduction.unwrap_or_else(|| {
+            self.bodies.iter().all(|b| self.material(&b.material).is_some_and(|m| m.thermal().is_some()))
+        })
     }
 
     /// TOML text of [`Case::resolved`].

@@ -15,6 +15,7 @@ pub mod geometry;
 pub mod model;
 pub mod neighbors;
 pub mod step;
+pub mod thermal;
 pub mod case;
 pub mod output;
 pub mod run;

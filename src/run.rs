@@ -8,6 +8,7 @@ use crate::contact::{ContactSystem, SlaveSet, SurfaceDetection};
 use crate::model::{Model, ModelError};
 use crate::output::OutputWriter;
 use crate::step::{Simulation, SolverError};
+use crate::thermal::HeatConduction;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -76,6 +77,8 @@ pub enum RunError {
     OutputDir { path: PathBuf, message: String },
     #[error(transparent)]
     Model(#[from] ModelError),
+    #[error("heat conduction setup: {0}")]
+    Heat(#[from] crate::thermal::HeatError),
     #[error("contact setup: {0}")]
     Contact(#[from] crate::contact::ContactError),
     #[error(transparent)]
@@ -109,8 +112,18 @@ pub fn prepare_output_dir(dir: &Path, force: bool) -> Result<(), RunError> {
 
 /// The simulation of a (resolved) case at t = 0: discretization, and
 /// contact with its rigid bodies if it has any (slaves: the surface
-/// particles, found geometrically).
+/// particles, found geometrically), and heat conduction if the case asks
+/// for it ([`Case::heat_conduction`]).
 pub fn build_simulation(case: &Case) -> Result<Simulation, RunError> {
+    let mut sim = build_mechanics(case)?;
+    if case.heat_conduction() {
+        sim.heat = Some(HeatConduction::new(&sim.model, case.heat.safety_factor)?);
+    }
+    Ok(sim)
+}
+
+/// The simulation without heat conduction.
+fn build_mechanics(case: &Case) -> Result<Simulation, RunError> {
     let model = Model::build(case.geometry.mode, &case.body_setups())?;
     let rule = case.time_step_rule();
     if case.rigid_bodies.is_empty() {

@@ -5,6 +5,7 @@ use crate::contact::{ContactError, ContactSystem, StepInput};
 use crate::material::{Constitutive, StepKinematics};
 use crate::math::{ddot, skew, sym, Real, Tensor3, Vec2};
 use crate::model::{constrain, Model};
+use crate::thermal::{HeatConduction, HeatError};
 use nalgebra::Matrix2;
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -64,6 +65,7 @@ pub struct StageTimers {
     pub contact: Duration,
     pub integration: Duration,
     pub material: Duration,
+    pub heat: Duration,
     pub internal_force: Duration,
     pub diagnostics: Duration,
 }
@@ -75,6 +77,7 @@ impl StageTimers {
             ("contact", self.contact),
             ("time integration", self.integration),
             ("velocity gradient + material", self.material),
+            ("heat conduction", self.heat),
             ("internal force", self.internal_force),
             ("diagnostics", self.diagnostics),
         ]
@@ -102,6 +105,13 @@ pub enum SolverError {
         step: u64,
         time: Real,
     },
+    #[error("heat conduction failed in step {step} (t = {time:.6e} s): {source}")]
+    Heat {
+        #[source]
+        source: HeatError,
+        step: u64,
+        time: Real,
+    },
     #[error(
         "particle {particle} moves at {speed:.3e} m/s, above the bound {bound:.3e} m/s, in step {step} \
          (t = {time:.6e} s); the solution has gone unstable (time step too large?)"
@@ -125,6 +135,8 @@ pub struct Simulation {
     pub speed_bound: Real,
     /// Contact with rigid bodies, if the case has any.
     pub contact: Option<ContactSystem>,
+    /// Heat conduction (SPEC §7), if the case asks for it.
+    pub heat: Option<HeatConduction>,
     /// Contact forces of the current step, per particle (scratch).
     pub f_contact: Vec<Vec2>,
     /// Per-point internal-energy increments of the last step (scratch).
@@ -164,6 +176,7 @@ impl Simulation {
             timers: StageTimers::default(),
             speed_bound: 10.0 * vmax.max(1000.0),
             contact: None,
+            heat: None,
             f_contact: vec![Vec2::zeros(); np],
             work_scratch: vec![0.0; nq],
         }
@@ -178,12 +191,15 @@ impl Simulation {
     ///    the contact reactions;
     /// 2. velocity gradient and deformation gradient at each quadrature point
     ///    (`F` at the new step, `ℓ = Ḟ F_mid⁻¹` at mid-step; SPEC §2);
-    /// 3. material update (SPEC §6) and `P w = τ F⁻ᵀ w_q`;
-    /// 4. internal force by gather over particles (SPEC §4);
-    /// 5. diagnostics: energies, non-finite values, runaway speeds.
+    /// 3. material update (SPEC §6) and `P w = τ F⁻ᵀ w_q`: the adiabatic
+    ///    phase, which heats the quadrature points by the plastic work;
+    /// 4. heat: conduction at the configuration of this step, sub-cycled if
+    ///    `Δt` exceeds its stable step (SPEC §7; `heat` set); the new
+    ///    temperatures act on the stress from the next step on;
+    /// 5. internal force by gather over particles (SPEC §4);
+    /// 6. diagnostics: energies, non-finite values, runaway speeds.
     ///
-    /// Contact, heat conduction and crack growth enter between these stages
-    /// as their modules land.
+    /// Crack growth enters between these stages as its module lands.
     pub fn step(&mut self) -> Result<(), SolverError> {
         let dt = self.dt;
         let tc = Instant::now();
@@ -193,6 +209,8 @@ impl Simulation {
         self.advance_rigid_bodies()?;
         let t1 = Instant::now();
         self.update_material(dt)?;
+        let th = Instant::now();
+        self.conduct_heat(dt)?;
         let t2 = Instant::now();
         self.internal_force();
         let t3 = Instant::now();
@@ -203,7 +221,8 @@ impl Simulation {
         let t4 = Instant::now();
         self.timers.contact += t0 - tc;
         self.timers.integration += t1 - t0;
-        self.timers.material += t2 - t1;
+        self.timers.material += th - t1;
+        self.timers.heat += t2 - th;
         self.timers.internal_force += t3 - t2;
         self.timers.diagnostics += t4 - t3;
         Ok(())
@@ -358,6 +377,16 @@ impl Simulation {
             });
         }
         self.energies.internal += self.work_scratch.iter().sum::<Real>();
+        Ok(())
+    }
+
+    /// The conduction phase (SPEC §7), if the case has one.
+    fn conduct_heat(&mut self, dt: Real) -> Result<(), SolverError> {
+        let Some(heat) = self.heat.as_mut() else {
+            return Ok(());
+        };
+        heat.conduct(&mut self.model, dt)
+            .map_err(|source| SolverError::Heat { source, step: self.step + 1, time: self.time + dt })?;
         Ok(())
     }
 
