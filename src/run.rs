@@ -118,6 +118,7 @@ pub fn build_simulation(case: &Case) -> Result<Simulation, RunError> {
     let mut sim = build_mechanics(case)?;
     if case.heat_conduction() {
         sim.heat = Some(HeatConduction::new(&sim.model, case.heat.safety_factor)?);
+        sim.heat_every = case.heat.every;
     }
     Ok(sim)
 }
