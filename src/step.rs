@@ -419,19 +419,29 @@ impl Simulation {
     }
 
     /// Catch NaN/Inf and runaway speeds right after the stages that make them.
+    ///
+    /// One fused pass over the particles finds whether anything is wrong (a
+    /// NaN stress reaches the internal force of every particle it touches);
+    /// only then do the detailed passes name the culprit.
     fn diagnose(&self) -> Result<(), SolverError> {
         let p = &self.model.particles;
         let (step, time) = (self.step, self.time);
+        let bound2 = self.speed_bound * self.speed_bound;
+        let healthy = (&p.v, &p.f_int)
+            .into_par_iter()
+            .all(|(v, f)| v.norm_squared() <= bound2 && f.x.is_finite() && f.y.is_finite());
+        if healthy {
+            return Ok(());
+        }
+        if let Some(q) = self.model.quad.tau.par_iter().position_first(|t: &Tensor3| !t.iter().all(|x| x.is_finite())) {
+            return Err(SolverError::NonFinite { field: "stress", location: "quadrature point", index: q, step, time });
+        }
         if let Some(i) = p.v.par_iter().position_first(|v| !v.x.is_finite() || !v.y.is_finite()) {
             return Err(SolverError::NonFinite { field: "velocity", location: "particle", index: i, step, time });
         }
         if let Some(i) = p.f_int.par_iter().position_first(|f| !f.x.is_finite() || !f.y.is_finite()) {
             return Err(SolverError::NonFinite { field: "internal force", location: "particle", index: i, step, time });
         }
-        if let Some(q) = self.model.quad.tau.par_iter().position_first(|t: &Tensor3| !t.iter().all(|x| x.is_finite())) {
-            return Err(SolverError::NonFinite { field: "stress", location: "quadrature point", index: q, step, time });
-        }
-        let bound2 = self.speed_bound * self.speed_bound;
         if let Some(i) = p.v.par_iter().position_first(|v| v.norm_squared() > bound2) {
             return Err(SolverError::Runaway { particle: i, speed: p.v[i].norm(), bound: self.speed_bound, step, time });
         }
