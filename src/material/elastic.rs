@@ -41,10 +41,10 @@ impl Constitutive for Elastic {
         self.density
     }
     fn bulk_modulus(&self) -> Real {
-        self.youngs_modulus / (3.0 * (1.0 - 2.0 * self.poisson_ratio))
+        super::isotropic_moduli(self.youngs_modulus, self.poisson_ratio).0
     }
     fn shear_modulus(&self) -> Real {
-        self.youngs_modulus / (2.0 * (1.0 + self.poisson_ratio))
+        super::isotropic_moduli(self.youngs_modulus, self.poisson_ratio).1
     }
     fn initial_temperature(&self) -> Real {
         self.room_temperature

@@ -130,6 +130,17 @@ impl Constitutive for Material {
     }
 }
 
+/// Isotropic elastic constants from Young's modulus and Poisson's ratio:
+/// `(K, G) = (E / (3(1 − 2ν)), E / (2(1 + ν)))`. The one place both models
+/// take them from.
+#[inline]
+pub fn isotropic_moduli(youngs_modulus: Real, poisson_ratio: Real) -> (Real, Real) {
+    (
+        youngs_modulus / (3.0 * (1.0 - 2.0 * poisson_ratio)),
+        youngs_modulus / (2.0 * (1.0 + poisson_ratio)),
+    )
+}
+
 /// Objective (Jaumann) update `τ ← τ + Δt (τ^∇ + w τ − τ w)` (SPEC §6, last
 /// line of the tangent update). The single place where the Jaumann rate is
 /// integrated, shared by every model.
