@@ -646,10 +646,10 @@ fn validate_grid(add: &mut impl FnMut(String, String), key: &str, g: &RectangleG
             add(format!("{key}.{name}"), format!("must be finite, got {v}"));
         }
     }
-    if !(g.x_max > g.x_min) {
+    if g.x_max.partial_cmp(&g.x_min) != Some(std::cmp::Ordering::Greater) {
         add(format!("{key}.x_max"), format!("must exceed x_min (zero or negative length): {} <= {}", g.x_max, g.x_min));
     }
-    if !(g.y_max > g.y_min) {
+    if g.y_max.partial_cmp(&g.y_min) != Some(std::cmp::Ordering::Greater) {
         add(format!("{key}.y_max"), format!("must exceed y_min (zero or negative thickness): {} <= {}", g.y_max, g.y_min));
     }
     if mode == GeometryMode::Axisymmetric && g.x_min < 0.0 {

@@ -395,7 +395,7 @@ impl Simulation {
             return Ok(());
         };
         self.heat_pending += dt;
-        if (self.step + 1) % self.heat_every.max(1) != 0 {
+        if !(self.step + 1).is_multiple_of(self.heat_every.max(1)) {
             return Ok(());
         }
         let span = std::mem::take(&mut self.heat_pending);

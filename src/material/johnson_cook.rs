@@ -679,7 +679,8 @@ impl JohnsonCook {
         // stress, so round-off-sized stresses (seen ahead of wave fronts)
         // would otherwise never pass a purely relative test.
         let scale = tau_bar.max(NEGLIGIBLE_STRESS_RATIO * g);
-        if !(3.0 * self.shear_modulus() * dt * rate <= NEGLIGIBLE_RELAXATION * scale) {
+        let relaxation = 3.0 * self.shear_modulus() * dt * rate;
+        if relaxation.is_nan() || relaxation > NEGLIGIBLE_RELAXATION * scale {
             return None;
         }
         // No deviator, no flow direction: nothing to book. A damage

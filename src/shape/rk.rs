@@ -43,6 +43,9 @@ pub enum ShapeError {
 /// conditions would lose more than six digits.
 pub const MAX_MOMENT_CONDITION: Real = 1e10;
 
+/// One row of a table: `(particle, N, ∇N)` entries.
+type Row = Vec<(u32, Real, Vec2)>;
+
 /// Scratch for one row, reused across points of a thread.
 #[derive(Default)]
 struct RowScratch {
@@ -66,7 +69,7 @@ fn row_at(
     search: &SupportSearch,
     vis: &dyn Visibility,
     scratch: &mut RowScratch,
-    out: &mut Vec<(u32, Real, Vec2)>,
+    out: &mut Row,
 ) -> Result<(), ShapeError> {
     // Legend: Z = X - X_I; p = scaled basis; phi = window; M = moment matrix.
     out.clear();
@@ -148,7 +151,7 @@ pub fn build_table(
     vis: &dyn Visibility,
 ) -> Result<ShapeTable, ShapeError> {
     let search = SupportSearch::new(x0, support);
-    let rows: Vec<Vec<(u32, Real, Vec2)>> = points
+    let rows: Vec<Row> = points
         .par_iter()
         .enumerate()
         .map_init(RowScratch::default, |scratch, (p, x)| {
@@ -171,18 +174,18 @@ pub fn rebuild_rows(
     vis: &dyn Visibility,
 ) -> Result<(), ShapeError> {
     let search = SupportSearch::new(x0, support);
-    let fresh: Vec<(usize, Vec<(u32, Real, Vec2)>)> = which
+    let fresh: Vec<(usize, Row)> = which
         .par_iter()
         .map_init(RowScratch::default, |scratch, &p| {
             let mut out = Vec::new();
             row_at(p, &points[p], x0, support, volume, &search, vis, scratch, &mut out).map(|_| (p, out))
         })
         .collect::<Result<_, _>>()?;
-    let mut replaced: Vec<Option<Vec<(u32, Real, Vec2)>>> = vec![None; table.rows()];
+    let mut replaced: Vec<Option<Row>> = vec![None; table.rows()];
     for (p, row) in fresh {
         replaced[p] = Some(row);
     }
-    let rows: Vec<Vec<(u32, Real, Vec2)>> = (0..table.rows())
+    let rows: Vec<Row> = (0..table.rows())
         .map(|p| match replaced[p].take() {
             Some(r) => r,
             None => table.range(p).map(|k| (table.index[k], table.value[k], table.grad[k])).collect(),
@@ -192,7 +195,7 @@ pub fn rebuild_rows(
     Ok(())
 }
 
-fn assemble(rows: Vec<Vec<(u32, Real, Vec2)>>) -> ShapeTable {
+fn assemble(rows: Vec<Row>) -> ShapeTable {
     let nnz = rows.iter().map(|r| r.len()).sum();
     let mut t = ShapeTable {
         offsets: Vec::with_capacity(rows.len() + 1),
