@@ -37,6 +37,9 @@ pub struct Case {
     /// Contact with the rigid bodies (SPEC §8).
     #[serde(default)]
     pub contact: crate::contact::ContactParameters,
+    /// Crack growth (SPEC §9). Default: no cracks.
+    #[serde(default)]
+    pub fracture: crate::fracture::FractureParameters,
     /// Time integration.
     pub time: TimeSpec,
     /// Output.
@@ -406,6 +409,9 @@ impl Case {
         }
         if !(self.contact.tolerance.is_finite() && self.contact.tolerance > 0.0) {
             add("contact.tolerance".into(), format!("must be > 0, got {}", self.contact.tolerance));
+        }
+        for (key, message) in self.fracture.problems() {
+            add(format!("fracture.{key}"), message);
         }
         positive(&mut add, "time.end", self.time.end, "s");
         if !(self.time.safety_factor > 0.0 && self.time.safety_factor <= 1.0) {

@@ -2,6 +2,7 @@
 //! timers, energy bookkeeping and instability detection.
 
 use crate::contact::{ContactError, ContactSystem, StepInput};
+use crate::fracture::{CrackGrowth, FractureError};
 use crate::material::{Constitutive, StepKinematics};
 use crate::math::{ddot, skew, sym, Real, Tensor3, Vec2};
 use crate::model::{constrain, Model};
@@ -65,6 +66,7 @@ pub struct StageTimers {
     pub integration: Duration,
     pub material: Duration,
     pub internal_force: Duration,
+    pub crack_growth: Duration,
     pub diagnostics: Duration,
 }
 
@@ -76,6 +78,7 @@ impl StageTimers {
             ("time integration", self.integration),
             ("velocity gradient + material", self.material),
             ("internal force", self.internal_force),
+            ("crack growth", self.crack_growth),
             ("diagnostics", self.diagnostics),
         ]
     }
@@ -107,6 +110,13 @@ pub enum SolverError {
          (t = {time:.6e} s); the solution has gone unstable (time step too large?)"
     )]
     Runaway { particle: usize, speed: Real, bound: Real, step: u64, time: Real },
+    #[error("crack growth failed in step {step} (t = {time:.6e} s): {source}")]
+    Fracture {
+        #[source]
+        source: FractureError,
+        step: u64,
+        time: Real,
+    },
 }
 
 /// The running simulation.
@@ -127,6 +137,8 @@ pub struct Simulation {
     pub contact: Option<ContactSystem>,
     /// Contact forces of the current step, per particle (scratch).
     pub f_contact: Vec<Vec2>,
+    /// Crack growth (SPEC §9), if the case has a fracture criterion.
+    pub cracks: Option<CrackGrowth>,
     /// Per-point internal-energy increments of the last step (scratch).
     work_scratch: Vec<Real>,
 }
@@ -165,6 +177,7 @@ impl Simulation {
             speed_bound: 10.0 * vmax.max(1000.0),
             contact: None,
             f_contact: vec![Vec2::zeros(); np],
+            cracks: None,
             work_scratch: vec![0.0; nq],
         }
     }
@@ -180,7 +193,11 @@ impl Simulation {
     ///    (`F` at the new step, `ℓ = Ḟ F_mid⁻¹` at mid-step; SPEC §2);
     /// 3. material update (SPEC §6) and `P w = τ F⁻ᵀ w_q`;
     /// 4. internal force by gather over particles (SPEC §4);
-    /// 5. diagnostics: energies, non-finite values, runaway speeds.
+    /// 5. crack growth (SPEC §9): nucleation, propagation, arrest at the
+    ///    state `t^{n+1}`; a split patches the tables and masses locally,
+    ///    adds the new faces to the contact slaves, and the internal force
+    ///    is recomputed from the new table;
+    /// 6. diagnostics: energies, non-finite values, runaway speeds.
     ///
     /// Contact, heat conduction and crack growth enter between these stages
     /// as their modules land.
@@ -196,6 +213,8 @@ impl Simulation {
         let t2 = Instant::now();
         self.internal_force();
         let t3 = Instant::now();
+        self.grow_cracks(dt)?;
+        let t3c = Instant::now();
         self.time += dt;
         self.step += 1;
         self.diagnose()?;
@@ -205,7 +224,31 @@ impl Simulation {
         self.timers.integration += t1 - t0;
         self.timers.material += t2 - t1;
         self.timers.internal_force += t3 - t2;
-        self.timers.diagnostics += t4 - t3;
+        self.timers.crack_growth += t3c - t3;
+        self.timers.diagnostics += t4 - t3c;
+        Ok(())
+    }
+
+    /// Crack growth at `t + Δt`; after a change the new crack-face
+    /// particles join the contact slaves and the internal force is
+    /// recomputed with the patched table.
+    fn grow_cracks(&mut self, dt: Real) -> Result<(), SolverError> {
+        let Some(cracks) = self.cracks.as_mut() else {
+            return Ok(());
+        };
+        let (step, time) = (self.step + 1, self.time + dt);
+        let faces = cracks
+            .grow(&mut self.model, time, step)
+            .map_err(|source| SolverError::Fracture { source, step, time })?;
+        if faces.is_empty() {
+            return Ok(());
+        }
+        if let Some(contact) = self.contact.as_mut() {
+            for i in faces {
+                contact.slaves.add(i);
+            }
+        }
+        self.internal_force();
         Ok(())
     }
 
