@@ -13,7 +13,8 @@ use crate::math::{Real, Vec2};
 use crate::model::{Gather, Model};
 use crate::neighbors::CellGrid;
 use crate::particles::{FaceSide, ParticleFlags};
-use crate::shape::rebuild_rows;
+use super::rows::{rebuild_rows_with_fallback, Basis};
+use std::collections::BTreeMap;
 
 /// Crack segments are extended by this many offsets `δ` beyond each end
 /// that is not a growing tip.
@@ -145,6 +146,11 @@ pub struct CrackGrowth {
     /// Reference positions binned for the circle searches (rebuilt when
     /// particles move or are added).
     grid: Option<CellGrid>,
+    /// Quadrature rows built with a reduced basis (too few visible
+    /// particles next to a crack; [`super::rows`]).
+    pub reduced_quadrature_rows: BTreeMap<usize, Basis>,
+    /// Particle rows built with a reduced basis.
+    pub reduced_particle_rows: BTreeMap<usize, Basis>,
 }
 
 /// A split to perform at a crack vertex.
@@ -159,7 +165,15 @@ struct Split {
 
 impl CrackGrowth {
     pub fn new(params: FractureParameters) -> Self {
-        CrackGrowth { params, cracks: Vec::new(), events: Vec::new(), segments: CrackSegments::default(), grid: None }
+        CrackGrowth {
+            params,
+            cracks: Vec::new(),
+            events: Vec::new(),
+            segments: CrackSegments::default(),
+            grid: None,
+            reduced_quadrature_rows: BTreeMap::new(),
+            reduced_particle_rows: BTreeMap::new(),
+        }
     }
 
     /// The opaque segments of all cracks.
@@ -526,7 +540,7 @@ impl CrackGrowth {
     /// the box `[lo, hi]` grown by the largest support, the gather, the
     /// lumped masses of the particles in the old or new rows, and restore
     /// the linear momentum `momentum` (module doc).
-    fn rebuild_local(&self, model: &mut Model, lo: Vec2, hi: Vec2, momentum: Vec2) -> Result<(), crate::shape::ShapeError> {
+    fn rebuild_local(&mut self, model: &mut Model, lo: Vec2, hi: Vec2, momentum: Vec2) -> Result<(), crate::shape::ShapeError> {
         let grow = model.particles.support.iter().cloned().fold(0.0, Real::max) * (1.0 + 1e-9);
         let (lo, hi) = (lo - Vec2::repeat(grow), hi + Vec2::repeat(grow));
         let inside = |x: &Vec2| x.x >= lo.x && x.x <= hi.x && x.y >= lo.y && x.y <= hi.y;
@@ -548,12 +562,18 @@ impl CrackGrowth {
         let vis = CrackVisibility { segments: &self.segments, x0: &p.x0, face_side: &p.face_side };
         let mut qp_shape = std::mem::take(&mut model.qp_shape);
         let mut particle_shape = std::mem::take(&mut model.particle_shape);
-        let r1 = rebuild_rows(&mut qp_shape, &rows_q, &model.quad.x0, &p.x0, &p.support, &p.volume, &vis);
-        let r2 = rebuild_rows(&mut particle_shape, &rows_p, &p.x0, &p.x0, &p.support, &p.volume, &vis);
+        let r1 = rebuild_rows_with_fallback(&mut qp_shape, &rows_q, &model.quad.x0, &p.x0, &p.support, &p.volume, &vis);
+        let r2 = rebuild_rows_with_fallback(&mut particle_shape, &rows_p, &p.x0, &p.x0, &p.support, &p.volume, &vis);
         model.qp_shape = qp_shape;
         model.particle_shape = particle_shape;
-        r1?;
-        r2?;
+        for (rows, reduced, map) in
+            [(&rows_q, r1?, &mut self.reduced_quadrature_rows), (&rows_p, r2?, &mut self.reduced_particle_rows)]
+        {
+            for r in rows {
+                map.remove(r);
+            }
+            map.extend(reduced);
+        }
         for &q in &rows_q {
             for k in model.qp_shape.range(q) {
                 touched[model.qp_shape.index[k] as usize] = true;

@@ -8,6 +8,8 @@
 //! - [`growth`]: [`CrackGrowth`], the crack-growth stage: criteria,
 //!   nucleation, propagation, arrest, splitting, the local rebuild of the
 //!   shape tables and lumped masses, and the crack event log.
+//! - [`rows`]: the local row rebuild, with a reduced basis where a crack
+//!   leaves too few visible particles (an acute wedge at a free surface).
 //!
 //! Everything is in the **reference configuration** (total Lagrangian):
 //! crack paths, the fan and circle tests, split offsets and visibility.
@@ -70,6 +72,7 @@
 
 pub mod geometry;
 pub mod growth;
+pub mod rows;
 pub mod visibility;
 
 pub use growth::{Crack, CrackEvent, CrackGrowth, CrackVertex, EventKind};
