@@ -200,3 +200,32 @@ impl Particles {
             .fold(Vec2::zeros(), |acc, (m, v)| acc + v * *m)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn split_copies_every_column_and_permute_moves_face_sides() {
+        let mut p = Particles::default();
+        p.push(Vec2::new(1.0, 2.0), 0.5, 0.1, 0.2, 300.0, 0, ParticleFlags(ParticleFlags::SLAVE));
+        p.u[0] = Vec2::new(1e-3, 0.0);
+        p.v[0] = Vec2::new(3.0, 4.0);
+        p.mass[0] = 7.0;
+        p.face_side[0] = Some(FaceSide {
+            vertex: Vec2::zeros(),
+            incoming: Vec2::new(0.0, -1.0),
+            outgoing: Vec2::new(0.0, -1.0),
+            left: true,
+            reach: 0.1,
+        });
+        let k = p.split(0);
+        assert_eq!(k, 1);
+        assert_eq!((p.x0[1], p.u[1], p.v[1], p.mass[1]), (p.x0[0], p.u[0], p.v[0], p.mass[0]));
+        assert_eq!((p.volume[1], p.spacing[1], p.support[1], p.temperature[1]), (0.5, 0.1, 0.2, 300.0));
+        assert_eq!((p.body[1], p.flags[1], p.face_side[1]), (p.body[0], p.flags[0], p.face_side[0]));
+        p.face_side[1] = None;
+        p.permute(&[1, 0]);
+        assert!(p.face_side[0].is_none() && p.face_side[1].is_some());
+    }
+}

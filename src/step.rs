@@ -113,7 +113,7 @@ pub enum SolverError {
     #[error("crack growth failed in step {step} (t = {time:.6e} s): {source}")]
     Fracture {
         #[source]
-        source: FractureError,
+        source: Box<FractureError>,
         step: u64,
         time: Real,
     },
@@ -239,7 +239,7 @@ impl Simulation {
         let (step, time) = (self.step + 1, self.time + dt);
         let faces = cracks
             .grow(&mut self.model, time, step)
-            .map_err(|source| SolverError::Fracture { source, step, time })?;
+            .map_err(|source| SolverError::Fracture { source: Box::new(source), step, time })?;
         if faces.is_empty() {
             return Ok(());
         }

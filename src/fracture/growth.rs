@@ -4,8 +4,10 @@
 //! [`crate::fracture`] for the choices and deviations.
 
 use super::geometry::{
-    left_bisector, left_normal, point_segment_distance, sector_angles, sector_contains, widest_empty_sector,
+    left_bisector, left_normal, point_segment_distance, sector_angles, sector_contains,
+    widest_empty_sector,
 };
+use super::rows::{rebuild_rows_with_fallback, Basis};
 use super::visibility::{CrackSegments, CrackVisibility};
 use super::{Criterion, FractureError, FractureParameters};
 use crate::geometry::GeometryMode;
@@ -13,16 +15,24 @@ use crate::math::{Real, Vec2};
 use crate::model::{Gather, Model};
 use crate::neighbors::CellGrid;
 use crate::particles::{FaceSide, ParticleFlags};
-use super::rows::{rebuild_rows_with_fallback, Basis};
 use std::collections::BTreeMap;
 
 /// Crack segments are extended by this many offsets `δ` beyond each end
 /// that is not a growing tip.
 pub const EXTENSION_PER_OFFSET: Real = 5.0;
 
+/// Smallest lumped mass of a re-lumped particle, as a fraction of its
+/// nodal mass `ρ ΔV_I` (see the module doc of [`crate::fracture`]).
+pub const MASS_FLOOR: Real = 0.5;
+
 /// A segment may not pass within this fraction of a particle's spacing of
 /// a particle it does not end at.
 const PASS_OVER_FRACTION: Real = 0.1;
+
+/// Angle between two non-zero vectors, rad.
+fn angle(a: &Vec2, b: &Vec2) -> Real {
+    (a.dot(b) / (a.norm() * b.norm())).clamp(-1.0, 1.0).acos()
+}
 
 /// What happened to a crack.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -105,7 +115,11 @@ impl Crack {
             .map(|k| {
                 let (a, b) = (self.vertices[k].x0, self.vertices[k + 1].x0);
                 let d = (b - a).normalize();
-                let b_ext = if k + 2 == n && self.growing() { 0.0 } else { ext };
+                let b_ext = if k + 2 == n && self.growing() {
+                    0.0
+                } else {
+                    ext
+                };
                 (a - d * ext, b + d * b_ext)
             })
             .collect()
@@ -183,7 +197,11 @@ impl CrackGrowth {
 
     /// The visibility of the current crack set for `model`'s particles.
     pub fn visibility<'a>(&'a self, model: &'a Model) -> CrackVisibility<'a> {
-        CrackVisibility { segments: &self.segments, x0: &model.particles.x0, face_side: &model.particles.face_side }
+        CrackVisibility {
+            segments: &self.segments,
+            x0: &model.particles.x0,
+            face_side: &model.particles.face_side,
+        }
     }
 
     /// Per-particle criterion value: the lumped projection of the
@@ -196,7 +214,10 @@ impl CrackGrowth {
         };
         let (mut acc, mut wsum) = (0.0, 0.0);
         for j in model.gather.range(i) {
-            let (k, q) = (model.gather.entry[j] as usize, model.gather.point[j] as usize);
+            let (k, q) = (
+                model.gather.entry[j] as usize,
+                model.gather.point[j] as usize,
+            );
             let w = model.qp_shape.value[k] * model.quad.weight[q];
             acc += w * col[q];
             wsum += w;
@@ -216,7 +237,11 @@ impl CrackGrowth {
             GeometryMode::PlaneStrain => 2,
             GeometryMode::Axisymmetric => 1,
         };
-        let mut t: Vec<Real> = self.cracks.iter().filter_map(|c| c.arrested.map(|a| a.0)).collect();
+        let mut t: Vec<Real> = self
+            .cracks
+            .iter()
+            .filter_map(|c| c.arrested.map(|a| a.0))
+            .collect();
         t.sort_by(|a, b| a.partial_cmp(b).expect("finite times"));
         t.get(needed - 1).copied()
     }
@@ -225,16 +250,24 @@ impl CrackGrowth {
     /// growing crack arrests or advances by at most one particle, then new
     /// cracks nucleate. Returns the new crack-face particles (for the
     /// contact slave set).
-    pub fn grow(&mut self, model: &mut Model, time: Real, step: u64) -> Result<Vec<usize>, FractureError> {
+    pub fn grow(
+        &mut self,
+        model: &mut Model,
+        time: Real,
+        step: u64,
+    ) -> Result<Vec<usize>, FractureError> {
         let Some(critical) = self.params.critical_value() else {
             return Ok(Vec::new());
         };
         let mut faces = Vec::new();
         for c in 0..self.cracks.len() {
-            let Some(tip) = self.cracks[c].tip else { continue };
+            let Some(tip) = self.cracks[c].tip else {
+                continue;
+            };
             self.ensure_grid(model);
             let d = self.cracks[c].direction();
             let xt = model.particles.x0[tip];
+            let mean = (xt - self.cracks[c].vertices[0].x0).normalize();
             let circle = self.circle(model, tip);
             let dirs: Vec<Vec2> = circle.iter().map(|&j| model.particles.x0[j] - xt).collect();
             let sector = widest_empty_sector(&dirs);
@@ -249,7 +282,7 @@ impl CrackGrowth {
                     continue;
                 }
                 let r = model.particles.x0[j] - xt;
-                if r.norm() == 0.0 || r.normalize().dot(&d).clamp(-1.0, 1.0).acos() > half_fan {
+                if r.norm() == 0.0 || angle(&r, &d) > half_fan || angle(&r, &mean) > half_fan {
                     continue;
                 }
                 let value = self.criterion_value(model, j);
@@ -281,14 +314,23 @@ impl CrackGrowth {
         arrest: bool,
     ) -> Result<(usize, Vec<usize>), FractureError> {
         if path.len() < 2 {
-            return Err(FractureError::InvalidPath("needs at least two particles".into()));
+            return Err(FractureError::InvalidPath(
+                "needs at least two particles".into(),
+            ));
         }
         let n = model.particles.len();
         if let Some(&bad) = path.iter().find(|&&i| i >= n) {
-            return Err(FractureError::InvalidPath(format!("particle {bad} does not exist ({n} particles)")));
+            return Err(FractureError::InvalidPath(format!(
+                "particle {bad} does not exist ({n} particles)"
+            )));
         }
-        if path.iter().any(|&i| model.particles.flags[i].has(ParticleFlags::CRACK_FACE)) {
-            return Err(FractureError::InvalidPath("a particle of the path is already on a crack face".into()));
+        if path
+            .iter()
+            .any(|&i| model.particles.flags[i].has(ParticleFlags::CRACK_FACE))
+        {
+            return Err(FractureError::InvalidPath(
+                "a particle of the path is already on a crack face".into(),
+            ));
         }
         let c = self.cracks.len();
         let mut faces = self.start_crack(model, path[0], path[1], Real::NAN, 0.0, 0)?;
@@ -314,11 +356,14 @@ impl CrackGrowth {
         let p = &model.particles;
         let r = self.params.radius_factor * p.spacing[i];
         let mut out = Vec::new();
-        self.grid.as_ref().expect("grid built").for_each_candidate(&p.x0[i], r, |j| {
-            if j != i && p.body[j] == p.body[i] && (p.x0[j] - p.x0[i]).norm() <= r {
-                out.push(j);
-            }
-        });
+        self.grid
+            .as_ref()
+            .expect("grid built")
+            .for_each_candidate(&p.x0[i], r, |j| {
+                if j != i && p.body[j] == p.body[i] && (p.x0[j] - p.x0[i]).norm() <= r {
+                    out.push(j);
+                }
+            });
         out.sort_unstable();
         out
     }
@@ -329,11 +374,18 @@ impl CrackGrowth {
         let (a, b) = (p.x0[i], p.x0[j]);
         let reach = (b - a).norm() + p.spacing[i];
         let mut hit = false;
-        self.grid.as_ref().expect("grid built").for_each_candidate(&a, reach.min(self.grid_cell(model)), |k| {
-            if k != i && k != j && point_segment_distance(&a, &b, &p.x0[k]) < PASS_OVER_FRACTION * p.spacing[k] {
-                hit = true;
-            }
-        });
+        self.grid.as_ref().expect("grid built").for_each_candidate(
+            &a,
+            reach.min(self.grid_cell(model)),
+            |k| {
+                if k != i
+                    && k != j
+                    && point_segment_distance(&a, &b, &p.x0[k]) < PASS_OVER_FRACTION * p.spacing[k]
+                {
+                    hit = true;
+                }
+            },
+        );
         hit
     }
 
@@ -352,7 +404,13 @@ impl CrackGrowth {
         self.segments.blocked(&start, &xj)
     }
 
-    fn nucleate(&mut self, model: &mut Model, critical: Real, time: Real, step: u64) -> Result<Vec<usize>, FractureError> {
+    fn nucleate(
+        &mut self,
+        model: &mut Model,
+        critical: Real,
+        time: Real,
+        step: u64,
+    ) -> Result<Vec<usize>, FractureError> {
         let mut cores: Vec<(Real, usize)> = (0..model.particles.len())
             .filter(|&i| {
                 let f = model.particles.flags[i];
@@ -375,7 +433,9 @@ impl CrackGrowth {
             let xi = model.particles.x0[i];
             let exclusion = self.params.nucleation_distance_factor * model.particles.spacing[i];
             let near = self.cracks.iter().any(|c| {
-                c.vertices.windows(2).any(|w| point_segment_distance(&w[0].x0, &w[1].x0, &xi) < exclusion)
+                c.vertices
+                    .windows(2)
+                    .any(|w| point_segment_distance(&w[0].x0, &w[1].x0, &xi) < exclusion)
             });
             if near {
                 continue;
@@ -384,14 +444,19 @@ impl CrackGrowth {
             let mut best: Option<(Real, usize)> = None;
             for j in self.circle(model, i) {
                 let f = model.particles.flags[j];
-                if f.has(ParticleFlags::CRACK_FACE) || f.has(ParticleFlags::SLAVE) || f.has(ParticleFlags::SURFACE) {
+                if f.has(ParticleFlags::CRACK_FACE)
+                    || f.has(ParticleFlags::SLAVE)
+                    || f.has(ParticleFlags::SURFACE)
+                {
                     continue;
                 }
                 let value = self.criterion_value(model, j);
                 if value < critical || best.is_some_and(|(bv, _)| bv >= value) {
                     continue;
                 }
-                if self.passes_over(model, i, j) || self.segments.blocked(&xi, &model.particles.x0[j]) {
+                if self.passes_over(model, i, j)
+                    || self.segments.blocked(&xi, &model.particles.x0[j])
+                {
                     continue;
                 }
                 best = Some((value, j));
@@ -419,16 +484,39 @@ impl CrackGrowth {
         let id = self.cracks.len();
         self.cracks.push(Crack {
             id,
-            vertices: vec![CrackVertex { x0: xi, faces: None }, CrackVertex { x0: xj, faces: None }],
+            vertices: vec![
+                CrackVertex {
+                    x0: xi,
+                    faces: None,
+                },
+                CrackVertex {
+                    x0: xj,
+                    faces: None,
+                },
+            ],
             tip: Some(j),
             offset,
             nucleated: (time, step),
             arrested: None,
         });
-        let split = Split { parent: i, vertex: xi, incoming: d, outgoing: d, reach: (xj - xi).norm(), offset };
+        let split = Split {
+            parent: i,
+            vertex: xi,
+            incoming: d,
+            outgoing: d,
+            reach: (xj - xi).norm(),
+            offset,
+        };
         let (l, r) = self.split(model, id, split)?;
         self.cracks[id].vertices[0].faces = Some((l as u32, r as u32));
-        self.events.push(CrackEvent { time, step, crack: id, kind: EventKind::Nucleate, particles: vec![l, r, j], value });
+        self.events.push(CrackEvent {
+            time,
+            step,
+            crack: id,
+            kind: EventKind::Nucleate,
+            particles: vec![l, r, j],
+            value,
+        });
         Ok(vec![l, r])
     }
 
@@ -448,7 +536,10 @@ impl CrackGrowth {
         let outgoing = (xj - xt).normalize();
         let n = self.cracks[c].vertices.len();
         let last_len = (xt - self.cracks[c].vertices[n - 2].x0).norm();
-        self.cracks[c].vertices.push(CrackVertex { x0: xj, faces: None });
+        self.cracks[c].vertices.push(CrackVertex {
+            x0: xj,
+            faces: None,
+        });
         self.cracks[c].tip = Some(j);
         let split = Split {
             parent: tip,
@@ -460,12 +551,25 @@ impl CrackGrowth {
         };
         let (l, r) = self.split(model, c, split)?;
         self.cracks[c].vertices[n - 1].faces = Some((l as u32, r as u32));
-        self.events.push(CrackEvent { time, step, crack: c, kind: EventKind::Propagate, particles: vec![l, r, j], value });
+        self.events.push(CrackEvent {
+            time,
+            step,
+            crack: c,
+            kind: EventKind::Propagate,
+            particles: vec![l, r, j],
+            value,
+        });
         Ok(vec![l, r])
     }
 
     /// Arrest: split the tip in halves, extend the path by δ, stop.
-    fn arrest(&mut self, model: &mut Model, c: usize, time: Real, step: u64) -> Result<Vec<usize>, FractureError> {
+    fn arrest(
+        &mut self,
+        model: &mut Model,
+        c: usize,
+        time: Real,
+        step: u64,
+    ) -> Result<Vec<usize>, FractureError> {
         let tip = self.cracks[c].tip.expect("growing");
         let value = self.criterion_value(model, tip);
         let xt = model.particles.x0[tip];
@@ -473,19 +577,41 @@ impl CrackGrowth {
         let n = self.cracks[c].vertices.len();
         let last_len = (xt - self.cracks[c].vertices[n - 2].x0).norm();
         let offset = self.cracks[c].offset;
-        self.cracks[c].vertices.push(CrackVertex { x0: xt + d * offset, faces: None });
+        self.cracks[c].vertices.push(CrackVertex {
+            x0: xt + d * offset,
+            faces: None,
+        });
         self.cracks[c].tip = None;
         self.cracks[c].arrested = Some((time, step));
-        let split = Split { parent: tip, vertex: xt, incoming: d, outgoing: d, reach: last_len, offset };
+        let split = Split {
+            parent: tip,
+            vertex: xt,
+            incoming: d,
+            outgoing: d,
+            reach: last_len,
+            offset,
+        };
         let (l, r) = self.split(model, c, split)?;
         self.cracks[c].vertices[n - 1].faces = Some((l as u32, r as u32));
-        self.events.push(CrackEvent { time, step, crack: c, kind: EventKind::Arrest, particles: vec![l, r], value });
+        self.events.push(CrackEvent {
+            time,
+            step,
+            crack: c,
+            kind: EventKind::Arrest,
+            particles: vec![l, r],
+            value,
+        });
         Ok(vec![l, r])
     }
 
     /// Split a particle at a crack vertex and rebuild what the change
     /// touches. The crack's path must already hold its new vertices.
-    fn split(&mut self, model: &mut Model, crack: usize, s: Split) -> Result<(usize, usize), FractureError> {
+    fn split(
+        &mut self,
+        model: &mut Model,
+        crack: usize,
+        s: Split,
+    ) -> Result<(usize, usize), FractureError> {
         let momentum = model.particles.momentum();
         let (phi_l, phi_r) = sector_angles(&s.incoming, &s.outgoing);
         let two_pi = 2.0 * std::f64::consts::PI;
@@ -495,7 +621,13 @@ impl CrackGrowth {
         let old_x = p.x0[s.parent];
         let l = s.parent;
         let r = p.split(l);
-        let side = |left: bool| FaceSide { vertex: s.vertex, incoming: s.incoming, outgoing: s.outgoing, left, reach: s.reach };
+        let side = |left: bool| FaceSide {
+            vertex: s.vertex,
+            incoming: s.incoming,
+            outgoing: s.outgoing,
+            left,
+            reach: s.reach,
+        };
         for (k, f, sign, left) in [(l, fl, 1.0, true), (r, fr, -1.0, false)] {
             p.x0[k] = s.vertex + b * (sign * s.offset);
             p.volume[k] *= f;
@@ -526,7 +658,11 @@ impl CrackGrowth {
             }
         }
         self.rebuild_local(model, lo, hi, momentum)
-            .map_err(|source| FractureError::Shape { crack, particle: l, source })?;
+            .map_err(|source| FractureError::Shape {
+                crack,
+                particle: l,
+                source,
+            })?;
         Ok((l, r))
     }
 
@@ -540,12 +676,20 @@ impl CrackGrowth {
     /// the box `[lo, hi]` grown by the largest support, the gather, the
     /// lumped masses of the particles in the old or new rows, and restore
     /// the linear momentum `momentum` (module doc).
-    fn rebuild_local(&mut self, model: &mut Model, lo: Vec2, hi: Vec2, momentum: Vec2) -> Result<(), crate::shape::ShapeError> {
+    fn rebuild_local(
+        &mut self,
+        model: &mut Model,
+        lo: Vec2,
+        hi: Vec2,
+        momentum: Vec2,
+    ) -> Result<(), crate::shape::ShapeError> {
         let grow = model.particles.support.iter().cloned().fold(0.0, Real::max) * (1.0 + 1e-9);
         let (lo, hi) = (lo - Vec2::repeat(grow), hi + Vec2::repeat(grow));
         let inside = |x: &Vec2| x.x >= lo.x && x.x <= hi.x && x.y >= lo.y && x.y <= hi.y;
         let n = model.particles.len();
-        let rows_q: Vec<usize> = (0..model.quad.len()).filter(|&q| inside(&model.quad.x0[q])).collect();
+        let rows_q: Vec<usize> = (0..model.quad.len())
+            .filter(|&q| inside(&model.quad.x0[q]))
+            .collect();
         let ps = &mut model.particle_shape;
         while ps.rows() < n {
             let end = *ps.offsets.last().expect("offsets start at 0");
@@ -559,16 +703,37 @@ impl CrackGrowth {
             }
         }
         let p = &model.particles;
-        let vis = CrackVisibility { segments: &self.segments, x0: &p.x0, face_side: &p.face_side };
+        let vis = CrackVisibility {
+            segments: &self.segments,
+            x0: &p.x0,
+            face_side: &p.face_side,
+        };
         let mut qp_shape = std::mem::take(&mut model.qp_shape);
         let mut particle_shape = std::mem::take(&mut model.particle_shape);
-        let r1 = rebuild_rows_with_fallback(&mut qp_shape, &rows_q, &model.quad.x0, &p.x0, &p.support, &p.volume, &vis);
-        let r2 = rebuild_rows_with_fallback(&mut particle_shape, &rows_p, &p.x0, &p.x0, &p.support, &p.volume, &vis);
+        let r1 = rebuild_rows_with_fallback(
+            &mut qp_shape,
+            &rows_q,
+            &model.quad.x0,
+            &p.x0,
+            &p.support,
+            &p.volume,
+            &vis,
+        );
+        let r2 = rebuild_rows_with_fallback(
+            &mut particle_shape,
+            &rows_p,
+            &p.x0,
+            &p.x0,
+            &p.support,
+            &p.volume,
+            &vis,
+        );
         model.qp_shape = qp_shape;
         model.particle_shape = particle_shape;
-        for (rows, reduced, map) in
-            [(&rows_q, r1?, &mut self.reduced_quadrature_rows), (&rows_p, r2?, &mut self.reduced_particle_rows)]
-        {
+        for (rows, reduced, map) in [
+            (&rows_q, r1?, &mut self.reduced_quadrature_rows),
+            (&rows_p, r2?, &mut self.reduced_particle_rows),
+        ] {
             for r in rows {
                 map.remove(r);
             }
@@ -581,15 +746,42 @@ impl CrackGrowth {
         }
         model.gather = Gather::new(&model.qp_shape, n);
         let touched: Vec<usize> = (0..n).filter(|&i| touched[i]).collect();
+        let before: Real = touched.iter().map(|&i| model.particles.mass[i]).sum();
+        let mut floored = Vec::new();
         for &i in &touched {
-            model.particles.mass[i] = model.lumped_mass(i);
+            let m = model.lumped_mass(i);
+            let rho = model.materials[model.particles.body[i] as usize].density();
+            let floor = MASS_FLOOR * rho * model.particles.volume[i];
+            if m < floor {
+                floored.push(i);
+            }
+            model.particles.mass[i] = m.max(floor);
+        }
+        if !floored.is_empty() {
+            // Take the floor's extra mass from the other re-lumped particles,
+            // in proportion to their masses: the total stays exact.
+            let p = &mut model.particles;
+            let after: Real = touched.iter().map(|&i| p.mass[i]).sum();
+            let rest: Real = touched.iter().filter(|i| !floored.contains(i)).map(|&i| p.mass[i]).sum();
+            let scale = 1.0 - (after - before) / rest;
+            for &i in touched.iter().filter(|i| !floored.contains(i)) {
+                p.mass[i] *= scale;
+            }
         }
         // Momentum: one uniform shift of the re-lumped particles' free components.
         let p = &mut model.particles;
         let dp = momentum - p.momentum();
         for c in 0..2 {
-            let fix = if c == 0 { ParticleFlags::FIX_X } else { ParticleFlags::FIX_Y };
-            let free: Vec<usize> = touched.iter().cloned().filter(|&i| !p.flags[i].has(fix)).collect();
+            let fix = if c == 0 {
+                ParticleFlags::FIX_X
+            } else {
+                ParticleFlags::FIX_Y
+            };
+            let free: Vec<usize> = touched
+                .iter()
+                .cloned()
+                .filter(|&i| !p.flags[i].has(fix))
+                .collect();
             let m: Real = free.iter().map(|&i| p.mass[i]).sum();
             if m > 0.0 {
                 let shift = dp[c] / m;

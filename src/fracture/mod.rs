@@ -47,6 +47,15 @@
 //!   surface). We read [RL10]'s `θ_max − θ_min > θ_c` as the width of that
 //!   empty sector between consecutive particle directions
 //!   (`arrest_at_the_far_surface_without_running_along_it`).
+//! - The fan is applied twice: candidates lie within `θ_c/2` of the last
+//!   segment's direction ([RL10]) **and** of the crack's mean direction
+//!   (nucleation point to tip). With the last segment alone a crack can
+//!   turn by up to `θ_c/2` per step and so U-turn in three steps; in the
+//!   Borvik plane-strain case both cracks did, ~7 rows down, hunting back
+//!   up into the corner's high strain while the material ahead of the tip
+//!   had not yet reached the criterion. With both fans the tip waits for
+//!   the material ahead (`splits_conserve_mass_and_momentum_and_reproduction`
+//!   exercises a slanted path, the case file the straight one).
 //! - A segment may not pass over a particle (within 0.1 h of its line)
 //!   without splitting it: such a candidate is skipped (the particle passed
 //!   over is itself the nearer candidate). Lattice particles off a
@@ -64,6 +73,17 @@
 //!   one uniform velocity shift of the re-lumped particles. It is of the
 //!   order of the velocity differences across a support times the mass
 //!   moved (`splits_conserve_mass_and_momentum_and_reproduction`).
+//! - Mass floor: at the apex of an acute wedge between a crack and the free
+//!   surface (a crack arriving obliquely), the bilinear RK function of the
+//!   apex particle is mostly negative over its few visible quadrature
+//!   points and its row-sum mass can come out negative (the Borvik
+//!   plane-strain run hit −0.05 kg/m at the first arrest). A re-lumped
+//!   mass is therefore held at no less than `MASS_FLOOR = ½` of the
+//!   particle's nodal mass `ρ ΔV_I`, the extra taken from the other
+//!   re-lumped particles in proportion to their masses (total mass exact);
+//!   momentum is then restored as above. Such particles' masses are no
+//!   longer row sums (`arrest_at_the_far_surface_without_running_along_it`
+//!   arrives at 45° and checks mass and momentum).
 //! - Crack segments are extended by `5 δ` beyond each end that is not a
 //!   growing tip, so sight lines grazing a split vertex are blocked.
 //! - After a change the internal force is recomputed from the new table
@@ -149,22 +169,47 @@ impl FractureParameters {
         let mut p = Vec::new();
         let pos = |v: Real| v.is_finite() && v > 0.0;
         if !pos(self.critical_effective_strain) {
-            p.push(("critical_effective_strain", format!("must be > 0, got {}", self.critical_effective_strain)));
+            p.push((
+                "critical_effective_strain",
+                format!("must be > 0, got {}", self.critical_effective_strain),
+            ));
         }
         if !pos(self.critical_damage) {
-            p.push(("critical_damage", format!("must be > 0, got {}", self.critical_damage)));
+            p.push((
+                "critical_damage",
+                format!("must be > 0, got {}", self.critical_damage),
+            ));
         }
         if !(self.radius_factor >= 1.0 && self.radius_factor <= 5.0) {
-            p.push(("radius_factor", format!("must lie in [1, 5] (local spacings), got {}", self.radius_factor)));
+            p.push((
+                "radius_factor",
+                format!(
+                    "must lie in [1, 5] (local spacings), got {}",
+                    self.radius_factor
+                ),
+            ));
         }
         if !(self.fan_angle > 0.0 && self.fan_angle < 180.0) {
-            p.push(("fan_angle", format!("must lie in (0, 180) degrees, got {}", self.fan_angle)));
+            p.push((
+                "fan_angle",
+                format!("must lie in (0, 180) degrees, got {}", self.fan_angle),
+            ));
         }
         if !(self.offset_ratio > 0.0 && self.offset_ratio <= 0.05) {
-            p.push(("offset_ratio", format!("must lie in (0, 0.05] (|delta| << spacing), got {}", self.offset_ratio)));
+            p.push((
+                "offset_ratio",
+                format!(
+                    "must lie in (0, 0.05] (|delta| << spacing), got {}",
+                    self.offset_ratio
+                ),
+            ));
         }
-        if !(self.nucleation_distance_factor.is_finite() && self.nucleation_distance_factor >= 0.0) {
-            p.push(("nucleation_distance_factor", format!("must be >= 0, got {}", self.nucleation_distance_factor)));
+        if !(self.nucleation_distance_factor.is_finite() && self.nucleation_distance_factor >= 0.0)
+        {
+            p.push((
+                "nucleation_distance_factor",
+                format!("must be >= 0, got {}", self.nucleation_distance_factor),
+            ));
         }
         p
     }
