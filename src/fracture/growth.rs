@@ -11,6 +11,7 @@ use super::rows::{rebuild_rows_with_fallback, Basis};
 use super::visibility::{CrackSegments, CrackVisibility};
 use super::{Criterion, FractureError, FractureParameters};
 use crate::geometry::GeometryMode;
+use crate::material::Constitutive;
 use crate::math::{Real, Vec2};
 use crate::model::{Gather, Model};
 use crate::neighbors::CellGrid;
