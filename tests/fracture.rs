@@ -119,6 +119,11 @@ fn check_invariants(m: &Model, growth: &CrackGrowth, before: &Invariants, what: 
         dp <= 1e-12 * before.mass * vmax,
         "{what}: momentum changed by {dp:e}"
     );
+    eprintln!(
+        "{what}: relative mass error {:.2e}, momentum error {:.2e} (of M v_max)",
+        (mass - before.mass).abs() / before.mass,
+        dp / (before.mass * vmax)
+    );
     let t = &m.qp_shape;
     for q in 0..t.rows() {
         let (mut s, mut sx, mut g, mut gx) = (
@@ -401,6 +406,7 @@ fn crack_faces_are_traction_free_under_tension() {
     let mean =
         |m: &Model| near.iter().map(|&q| sigma_yy(m, q).abs()).sum::<Real>() / near.len() as Real;
     let (s_intact, s_cracked) = (mean(&intact), mean(&cracked));
+    eprintln!("mean |sigma_yy| next to the faces: intact {s_intact:.3e} Pa, cracked {s_cracked:.3e} Pa");
     assert!(
         s_intact > 50e6,
         "the intact plate carries the load: {s_intact:e} Pa"
