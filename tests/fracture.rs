@@ -406,7 +406,9 @@ fn crack_faces_are_traction_free_under_tension() {
     let mean =
         |m: &Model| near.iter().map(|&q| sigma_yy(m, q).abs()).sum::<Real>() / near.len() as Real;
     let (s_intact, s_cracked) = (mean(&intact), mean(&cracked));
-    eprintln!("mean |sigma_yy| next to the faces: intact {s_intact:.3e} Pa, cracked {s_cracked:.3e} Pa");
+    eprintln!(
+        "mean |sigma_yy| next to the faces: intact {s_intact:.3e} Pa, cracked {s_cracked:.3e} Pa"
+    );
     assert!(
         s_intact > 50e6,
         "the intact plate carries the load: {s_intact:e} Pa"

@@ -22,6 +22,10 @@ use std::collections::BTreeMap;
 /// that is not a growing tip.
 pub const EXTENSION_PER_OFFSET: Real = 5.0;
 
+/// A crack segment that starts or ends on the outer surface makes at most
+/// this angle with the surface normal, degrees (module doc).
+pub const MAX_SURFACE_OBLIQUITY: Real = 40.0;
+
 /// Smallest lumped mass of a re-lumped particle, as a fraction of its
 /// nodal mass `ρ ΔV_I` (see the module doc of [`crate::fracture`]).
 pub const MASS_FLOOR: Real = 0.5;
@@ -293,6 +297,11 @@ impl CrackGrowth {
                 if self.passes_over(model, tip, j) || self.blocked_from_tip(model, c, j) {
                     continue;
                 }
+                if let Some(n) = self.outward_normal(model, j) {
+                    if angle(&r, &n) > MAX_SURFACE_OBLIQUITY.to_radians() {
+                        continue;
+                    }
+                }
                 best = Some((value, j));
             }
             if let Some((value, j)) = best {
@@ -367,6 +376,22 @@ impl CrackGrowth {
             });
         out.sort_unstable();
         out
+    }
+
+    /// Outward normal of the outer surface at particle `i` (the bisector of
+    /// the empty sector wider than `θ_c` in its circle), if it is on one.
+    fn outward_normal(&self, model: &Model, i: usize) -> Option<Vec2> {
+        let xi = model.particles.x0[i];
+        let dirs: Vec<Vec2> = self
+            .circle(model, i)
+            .iter()
+            .map(|&j| model.particles.x0[j] - xi)
+            .collect();
+        let (width, start) = widest_empty_sector(&dirs);
+        (width > self.params.fan_angle.to_radians()).then(|| {
+            let a = start + 0.5 * width;
+            Vec2::new(a.cos(), a.sin())
+        })
     }
 
     /// Whether segment `X_i X_j` passes over a third particle.
@@ -458,6 +483,11 @@ impl CrackGrowth {
                 if self.passes_over(model, i, j)
                     || self.segments.blocked(&xi, &model.particles.x0[j])
                 {
+                    continue;
+                }
+                let inward = self.outward_normal(model, i).map(|n| -n);
+                let oblique = MAX_SURFACE_OBLIQUITY.to_radians();
+                if inward.is_some_and(|n| angle(&(model.particles.x0[j] - xi), &n) > oblique) {
                     continue;
                 }
                 best = Some((value, j));
@@ -763,7 +793,11 @@ impl CrackGrowth {
             // in proportion to their masses: the total stays exact.
             let p = &mut model.particles;
             let after: Real = touched.iter().map(|&i| p.mass[i]).sum();
-            let rest: Real = touched.iter().filter(|i| !floored.contains(i)).map(|&i| p.mass[i]).sum();
+            let rest: Real = touched
+                .iter()
+                .filter(|i| !floored.contains(i))
+                .map(|&i| p.mass[i])
+                .sum();
             let scale = 1.0 - (after - before) / rest;
             for &i in touched.iter().filter(|i| !floored.contains(i)) {
                 p.mass[i] *= scale;

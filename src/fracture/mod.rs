@@ -73,6 +73,16 @@
 //!   one uniform velocity shift of the re-lumped particles. It is of the
 //!   order of the velocity differences across a support times the mass
 //!   moved (`splits_conserve_mass_and_momentum_and_reproduction`).
+//! - No acute wedges at the outer surface: a segment that starts (at
+//!   nucleation) or ends (arrival at the far surface) on the outer surface
+//!   makes at most `MAX_SURFACE_OBLIQUITY = 40°` with the surface normal
+//!   (the bisector of the surface particle's empty sector), so the two
+//!   wedges of material it leaves are at least 50°. In the Borvik
+//!   plane-strain run a crack that arrived along a 45° lattice diagonal
+//!   left a 45° wedge whose apex qp (a Gauss point on the diagonal) saw
+//!   too few particles and inverted two steps after arrest; the lattice
+//!   directions `(±1, 2)` (26.6°) and `(0, 1)` remain, and the tip waits
+//!   for them to meet the criterion.
 //! - Mass floor: at the apex of an acute wedge between a crack and the free
 //!   surface (a crack arriving obliquely), the bilinear RK function of the
 //!   apex particle is mostly negative over its few visible quadrature
