@@ -40,6 +40,9 @@ pub struct Case {
     /// Heat conduction (SPEC §7).
     #[serde(default)]
     pub heat: HeatSpec,
+    /// Crack growth (SPEC §9). Default: no cracks.
+    #[serde(default)]
+    pub fracture: crate::fracture::FractureParameters,
     /// Time integration.
     pub time: TimeSpec,
     /// Output.
@@ -475,6 +478,9 @@ impl Case {
                     );
                 }
             }
+        }
+        for (key, message) in self.fracture.problems() {
+            add(format!("fracture.{key}"), message);
         }
         positive(&mut add, "time.end", self.time.end, "s");
         if !(self.time.safety_factor > 0.0 && self.time.safety_factor <= 1.0) {

@@ -13,6 +13,7 @@ pub mod shape;
 pub mod discretize;
 pub mod geometry;
 pub mod model;
+pub mod fracture;
 pub mod neighbors;
 pub mod step;
 pub mod thermal;

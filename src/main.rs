@@ -352,6 +352,20 @@ fn run(case: &Case, file: &str, set: &[String], out_dir: PathBuf, force: bool) -
     }
     let qp_rate = s.quadrature_points as f64 * s.steps as f64 / s.loop_wall.as_secs_f64().max(1e-9);
     println!("  throughput {:.3e} quadrature-point updates/s, {:.1} steps/s", qp_rate, s.steps as f64 / s.loop_wall.as_secs_f64().max(1e-9));
+    for (name, v) in &s.rigid_velocities {
+        println!("  rigid body {name}: final velocity ({:.2}, {:.2}) m/s", v[0], v[1]);
+    }
+    for (id, nucleated, arrested) in &s.cracks {
+        match arrested {
+            Some(a) => println!("  crack {id}: nucleated at {:.3} us, arrested at {:.3} us", nucleated * 1e6, a * 1e6),
+            None => println!("  crack {id}: nucleated at {:.3} us, still growing", nucleated * 1e6),
+        }
+    }
+    if let Some(t) = s.separation {
+        println!("  plug separated at {:.3} us (its cracks arrested through the thickness)", t * 1e6);
+    } else if !s.cracks.is_empty() {
+        println!("  plug not separated");
+    }
     println!("  output: {} snapshots in {}/results.pvd, history in history.csv", s.snapshots, s.out_dir.display());
     for p in &s.plots {
         println!("  plot: {}", p.display());

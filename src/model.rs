@@ -254,16 +254,20 @@ impl Model {
 
     /// Row-sum lumped masses `m_I = Σ_q ρ₀ N_I(X_q) w_q` (SPEC §4).
     pub fn lump_masses(&mut self) {
-        let p = &mut self.particles;
-        for i in 0..p.len() {
-            let mut m = 0.0;
-            for j in self.gather.range(i) {
-                let (k, q) = (self.gather.entry[j] as usize, self.gather.point[j] as usize);
-                let rho = self.materials[self.quad.body[q] as usize].density();
-                m += rho * self.qp_shape.value[k] * self.quad.weight[q];
-            }
-            p.mass[i] = m;
+        for i in 0..self.particles.len() {
+            self.particles.mass[i] = self.lumped_mass(i);
         }
+    }
+
+    /// Row-sum lumped mass of particle `i` from the current tables (SPEC §4).
+    pub fn lumped_mass(&self, i: usize) -> Real {
+        let mut m = 0.0;
+        for j in self.gather.range(i) {
+            let (k, q) = (self.gather.entry[j] as usize, self.gather.point[j] as usize);
+            let rho = self.materials[self.quad.body[q] as usize].density();
+            m += rho * self.qp_shape.value[k] * self.quad.weight[q];
+        }
+        m
     }
 
     /// Zero the constrained components of `U` and `V`: supports, and the

@@ -29,6 +29,13 @@ pub const HISTORY_COLUMNS: &[&str] = &[
     "energy_drift",
 ];
 
+/// Columns of `cracks.csv`: one row per crack event; `particles` lists the
+/// split particle (left child), the new right child and, for nucleate and
+/// propagate, the new tip, separated by spaces; `value` is the criterion
+/// value of the new tip (of the split tip at arrest; empty for an inserted
+/// pre-crack).
+pub const CRACK_COLUMNS: &[&str] = &["time", "step", "crack", "kind", "particles", "value"];
+
 /// Per-rigid-body history column suffixes.
 pub const RIGID_COLUMNS: &[&str] = &["x", "y", "vx", "vy", "fx", "fy", "contacts"];
 
@@ -50,6 +57,10 @@ pub struct OutputWriter {
     history: HistoryWriter,
     /// Number of snapshots written so far.
     pub snapshots: usize,
+    /// `cracks.csv`, opened at the first crack event.
+    crack_log: Option<std::io::BufWriter<std::fs::File>>,
+    /// Crack events written so far.
+    crack_events_written: usize,
 }
 
 impl OutputWriter {
@@ -63,6 +74,8 @@ impl OutputWriter {
             series: PvdSeries::create(&dir.join("results.pvd"))?,
             history: HistoryWriter::create(&dir.join("history.csv"), &cols)?,
             snapshots: 0,
+            crack_log: None,
+            crack_events_written: 0,
         })
     }
 
@@ -77,6 +90,11 @@ impl OutputWriter {
         let path = self.dir.join(&name);
         write_vtu(&path, &particle_piece(&sim.model, &self.fields))?;
         self.series.append(sim.time, &name, 0)?;
+        if let Some(cracks) = &sim.cracks {
+            let crack_name = format!("cracks_{:05}.vtu", self.snapshots);
+            write_vtu(&self.dir.join(&crack_name), &crack_piece(&sim.model, cracks))?;
+            self.series.append(sim.time, &crack_name, 1)?;
+        }
         self.snapshots += 1;
         Ok(path)
     }
@@ -112,6 +130,57 @@ impl OutputWriter {
         }
         self.history.write_row(&row)
     }
+}
+
+impl OutputWriter {
+    /// Append the crack events not yet written to `cracks.csv` (created at
+    /// the first event, with the header [`CRACK_COLUMNS`]).
+    pub fn crack_events(&mut self, sim: &Simulation) -> Result<(), IoError> {
+        use std::io::Write;
+        let Some(cracks) = &sim.cracks else {
+            return Ok(());
+        };
+        if cracks.events.len() == self.crack_events_written {
+            return Ok(());
+        }
+        let path = self.dir.join("cracks.csv");
+        let err = |source| IoError::Write { path: path.clone(), source };
+        if self.crack_log.is_none() {
+            let mut f = std::io::BufWriter::new(std::fs::File::create(&path).map_err(err)?);
+            writeln!(f, "{}", CRACK_COLUMNS.join(",")).map_err(err)?;
+            self.crack_log = Some(f);
+        }
+        let f = self.crack_log.as_mut().expect("opened");
+        for e in &cracks.events[self.crack_events_written..] {
+            let ids: Vec<String> = e.particles.iter().map(|i| i.to_string()).collect();
+            let value = if e.value.is_finite() { format!("{:.6e}", e.value) } else { String::new() };
+            writeln!(f, "{:.9e},{},{},{},{},{}", e.time, e.step, e.crack, e.kind.name(), ids.join(" "), value)
+                .map_err(err)?;
+        }
+        f.flush().map_err(err)?;
+        self.crack_events_written = cracks.events.len();
+        Ok(())
+    }
+}
+
+/// The cracks as poly-lines in the current configuration: two per crack
+/// (its left and right faces, which coincide until the crack opens), with
+/// cell data `crack` (id) and `face` (0 left, 1 right of the direction of
+/// growth).
+pub fn crack_piece(model: &Model, cracks: &crate::fracture::CrackGrowth) -> VtuPiece {
+    let (mut points, mut lines, mut ids, mut faces) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for c in &cracks.cracks {
+        for (f, line) in c.face_polylines(model).iter().enumerate() {
+            let start = points.len() as u32;
+            points.extend(line.iter().map(v3));
+            lines.push((start..points.len() as u32).collect());
+            ids.push(c.id as i32);
+            faces.push(f as i32);
+        }
+    }
+    VtuPiece::poly_lines(points, lines)
+        .with_cell_data(DataArray::integers("crack", ids))
+        .with_cell_data(DataArray::integers("face", faces))
 }
 
 fn v3(v: &Vec2) -> [f64; 3] {

@@ -46,6 +46,27 @@ impl ParticleFlags {
     }
 }
 
+/// The side of a crack a split particle belongs to (SPEC §9): the crack
+/// vertex `vertex` it was split at, the crack path's unit directions into
+/// (`incoming`) and out of (`outgoing`) that vertex, and which side of the
+/// path (`left` of the direction of growth, or right) the particle lies on.
+/// Within `reach` of the vertex (the length of the shorter adjacent crack
+/// segment) the particle is visible only from its own side; farther away
+/// the crack segments themselves decide (see `fracture::visibility`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FaceSide {
+    /// Reference position of the crack vertex, m.
+    pub vertex: Vec2,
+    /// Unit direction of the crack path arriving at the vertex.
+    pub incoming: Vec2,
+    /// Unit direction of the crack path leaving the vertex.
+    pub outgoing: Vec2,
+    /// On the left of the path (seen along the direction of growth).
+    pub left: bool,
+    /// Radius around the vertex within which the side test applies, m.
+    pub reach: Real,
+}
+
 /// All particles of all deformable bodies.
 #[derive(Clone, Debug, Default)]
 pub struct Particles {
@@ -76,6 +97,9 @@ pub struct Particles {
     pub body: Vec<u32>,
     /// Role flags.
     pub flags: Vec<ParticleFlags>,
+    /// Crack side of a particle created by splitting (SPEC §9); `None` for
+    /// every particle not on a crack face.
+    pub face_side: Vec<Option<FaceSide>>,
 }
 
 impl Particles {
@@ -111,6 +135,33 @@ impl Particles {
         self.temperature.push(temperature);
         self.body.push(body);
         self.flags.push(flags);
+        self.face_side.push(None);
+        self.len() - 1
+    }
+
+    /// Append an exact copy of particle `i` (every column) and return its
+    /// index. Particle splitting (SPEC §9) starts here and then sets what
+    /// differs (position, volume, mass, acceleration); a column added to
+    /// the store is copied without the splitter knowing about it.
+    pub fn split(&mut self, i: usize) -> usize {
+        fn c<T: Copy>(v: &mut Vec<T>, i: usize) {
+            let x = v[i];
+            v.push(x);
+        }
+        c(&mut self.x0, i);
+        c(&mut self.u, i);
+        c(&mut self.v, i);
+        c(&mut self.a, i);
+        c(&mut self.f_int, i);
+        c(&mut self.f_ext, i);
+        c(&mut self.mass, i);
+        c(&mut self.volume, i);
+        c(&mut self.spacing, i);
+        c(&mut self.support, i);
+        c(&mut self.temperature, i);
+        c(&mut self.body, i);
+        c(&mut self.flags, i);
+        c(&mut self.face_side, i);
         self.len() - 1
     }
 
@@ -133,6 +184,7 @@ impl Particles {
         p(&mut self.temperature, order);
         p(&mut self.body, order);
         p(&mut self.flags, order);
+        p(&mut self.face_side, order);
     }
 
     /// Total mass, kg.
@@ -146,5 +198,34 @@ impl Particles {
             .iter()
             .zip(&self.v)
             .fold(Vec2::zeros(), |acc, (m, v)| acc + v * *m)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn split_copies_every_column_and_permute_moves_face_sides() {
+        let mut p = Particles::default();
+        p.push(Vec2::new(1.0, 2.0), 0.5, 0.1, 0.2, 300.0, 0, ParticleFlags(ParticleFlags::SLAVE));
+        p.u[0] = Vec2::new(1e-3, 0.0);
+        p.v[0] = Vec2::new(3.0, 4.0);
+        p.mass[0] = 7.0;
+        p.face_side[0] = Some(FaceSide {
+            vertex: Vec2::zeros(),
+            incoming: Vec2::new(0.0, -1.0),
+            outgoing: Vec2::new(0.0, -1.0),
+            left: true,
+            reach: 0.1,
+        });
+        let k = p.split(0);
+        assert_eq!(k, 1);
+        assert_eq!((p.x0[1], p.u[1], p.v[1], p.mass[1]), (p.x0[0], p.u[0], p.v[0], p.mass[0]));
+        assert_eq!((p.volume[1], p.spacing[1], p.support[1], p.temperature[1]), (0.5, 0.1, 0.2, 300.0));
+        assert_eq!((p.body[1], p.flags[1], p.face_side[1]), (p.body[0], p.flags[0], p.face_side[0]));
+        p.face_side[1] = None;
+        p.permute(&[1, 0]);
+        assert!(p.face_side[0].is_none() && p.face_side[1].is_some());
     }
 }

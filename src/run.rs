@@ -68,6 +68,12 @@ pub struct RunSummary {
     pub out_dir: PathBuf,
     /// PNG plots written at the end.
     pub plots: Vec<PathBuf>,
+    /// Each crack: id, nucleation time (s), arrest time (s) if it arrested.
+    pub cracks: Vec<(usize, Real, Option<Real>)>,
+    /// When the plug separated (all cracks that cut it out arrested), s.
+    pub separation: Option<Real>,
+    /// Velocity of each rigid body at the end, (name, (vx, vy)) m/s.
+    pub rigid_velocities: Vec<(String, [Real; 2])>,
 }
 
 /// Why a run stopped.
@@ -115,16 +121,19 @@ pub fn prepare_output_dir(dir: &Path, force: bool) -> Result<(), RunError> {
 /// particles, found geometrically), and heat conduction if the case asks
 /// for it ([`Case::heat_conduction`]).
 pub fn build_simulation(case: &Case) -> Result<Simulation, RunError> {
-    let mut sim = build_mechanics(case)?;
+    let mut sim = build_simulation_without_cracks(case)?;
     if case.heat_conduction() {
         sim.heat = Some(HeatConduction::new(&sim.model, case.heat.safety_factor)?);
         sim.heat_every = case.heat.every;
     }
+    if case.fracture.criterion != crate::fracture::Criterion::None {
+        sim.cracks = Some(crate::fracture::CrackGrowth::new(case.fracture));
+    }
     Ok(sim)
 }
 
-/// The simulation without heat conduction.
-fn build_mechanics(case: &Case) -> Result<Simulation, RunError> {
+/// The simulation without heat conduction and cracks.
+fn build_simulation_without_cracks(case: &Case) -> Result<Simulation, RunError> {
     let model = Model::build(case.geometry.mode, &case.body_setups())?;
     let rule = case.time_step_rule();
     if case.rigid_bodies.is_empty() {
@@ -189,7 +198,9 @@ pub fn execute(case: &Case, cfg: &RunConfig, progress: &mut dyn FnMut(Progress))
         if done {
             break;
         }
-        if let Err(error) = sim.step() {
+        let stepped = sim.step();
+        out.crack_events(&sim)?;
+        if let Err(error) = stepped {
             let last = out.snapshot(&sim)?;
             out.history_row(&sim)?;
             return Err(RunError::Unstable { error, last_snapshot: last, dir: cfg.out_dir.clone() });
@@ -202,7 +213,22 @@ pub fn execute(case: &Case, cfg: &RunConfig, progress: &mut dyn FnMut(Progress))
     let t = Instant::now();
     let plots = crate::output::plot_history(&cfg.out_dir)?;
     output_wall += t.elapsed();
+    let (cracks, separation) = match &sim.cracks {
+        Some(c) => (
+            c.cracks.iter().map(|k| (k.id, k.nucleated.0, k.arrested.map(|a| a.0))).collect(),
+            c.separation_time(sim.model.mode),
+        ),
+        None => (Vec::new(), None),
+    };
+    let rigid_velocities = sim
+        .contact
+        .as_ref()
+        .map(|c| c.bodies.iter().map(|b| (b.name.clone(), [b.velocity.x, b.velocity.y])).collect())
+        .unwrap_or_default();
     Ok(RunSummary {
+        cracks,
+        separation,
+        rigid_velocities,
         plots,
         particles: sim.model.particles.len(),
         quadrature_points: sim.model.quad.len(),

@@ -2,6 +2,7 @@
 //! timers, energy bookkeeping and instability detection.
 
 use crate::contact::{ContactError, ContactSystem, StepInput};
+use crate::fracture::{CrackGrowth, FractureError};
 use crate::material::{Constitutive, StepKinematics};
 use crate::math::{ddot, skew, sym, Real, Tensor3, Vec2};
 use crate::model::{constrain, Model};
@@ -67,6 +68,7 @@ pub struct StageTimers {
     pub material: Duration,
     pub heat: Duration,
     pub internal_force: Duration,
+    pub crack_growth: Duration,
     pub diagnostics: Duration,
 }
 
@@ -79,6 +81,7 @@ impl StageTimers {
             ("velocity gradient + material", self.material),
             ("heat conduction", self.heat),
             ("internal force", self.internal_force),
+            ("crack growth", self.crack_growth),
             ("diagnostics", self.diagnostics),
         ]
     }
@@ -117,6 +120,13 @@ pub enum SolverError {
          (t = {time:.6e} s); the solution has gone unstable (time step too large?)"
     )]
     Runaway { particle: usize, speed: Real, bound: Real, step: u64, time: Real },
+    #[error("crack growth failed in step {step} (t = {time:.6e} s): {source}")]
+    Fracture {
+        #[source]
+        source: Box<FractureError>,
+        step: u64,
+        time: Real,
+    },
 }
 
 /// The running simulation.
@@ -143,6 +153,8 @@ pub struct Simulation {
     pub heat_pending: Real,
     /// Contact forces of the current step, per particle (scratch).
     pub f_contact: Vec<Vec2>,
+    /// Crack growth (SPEC §9), if the case has a fracture criterion.
+    pub cracks: Option<CrackGrowth>,
     /// Per-point internal-energy increments of the last step (scratch).
     work_scratch: Vec<Real>,
 }
@@ -184,6 +196,7 @@ impl Simulation {
             heat_every: 1,
             heat_pending: 0.0,
             f_contact: vec![Vec2::zeros(); np],
+            cracks: None,
             work_scratch: vec![0.0; nq],
         }
     }
@@ -203,9 +216,11 @@ impl Simulation {
     ///    `Δt` exceeds its stable step (SPEC §7; `heat` set); the new
     ///    temperatures act on the stress from the next step on;
     /// 5. internal force by gather over particles (SPEC §4);
-    /// 6. diagnostics: energies, non-finite values, runaway speeds.
-    ///
-    /// Crack growth enters between these stages as its module lands.
+    /// 6. crack growth (SPEC §9): nucleation, propagation, arrest at the
+    ///    state `t^{n+1}`; a split patches the tables and masses locally,
+    ///    adds the new faces to the contact slaves, and the internal force
+    ///    is recomputed from the new table;
+    /// 7. diagnostics: energies, non-finite values, runaway speeds.
     pub fn step(&mut self) -> Result<(), SolverError> {
         let dt = self.dt;
         let tc = Instant::now();
@@ -220,6 +235,8 @@ impl Simulation {
         let t2 = Instant::now();
         self.internal_force();
         let t3 = Instant::now();
+        self.grow_cracks(dt)?;
+        let t3c = Instant::now();
         self.time += dt;
         self.step += 1;
         self.diagnose()?;
@@ -230,7 +247,31 @@ impl Simulation {
         self.timers.material += th - t1;
         self.timers.heat += t2 - th;
         self.timers.internal_force += t3 - t2;
-        self.timers.diagnostics += t4 - t3;
+        self.timers.crack_growth += t3c - t3;
+        self.timers.diagnostics += t4 - t3c;
+        Ok(())
+    }
+
+    /// Crack growth at `t + Δt`; after a change the new crack-face
+    /// particles join the contact slaves and the internal force is
+    /// recomputed with the patched table.
+    fn grow_cracks(&mut self, dt: Real) -> Result<(), SolverError> {
+        let Some(cracks) = self.cracks.as_mut() else {
+            return Ok(());
+        };
+        let (step, time) = (self.step + 1, self.time + dt);
+        let faces = cracks
+            .grow(&mut self.model, time, step)
+            .map_err(|source| SolverError::Fracture { source: Box::new(source), step, time })?;
+        if faces.is_empty() {
+            return Ok(());
+        }
+        if let Some(contact) = self.contact.as_mut() {
+            for i in faces {
+                contact.slaves.add(i);
+            }
+        }
+        self.internal_force();
         Ok(())
     }
 

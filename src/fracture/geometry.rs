@@ -1,0 +1,210 @@
+//! Plane geometry of crack paths in the reference configuration (SPEC §9):
+//! sight-line blocking, the side of a split particle, the angle fractions
+//! of a split, and the empty-sector (outer-surface) test.
+
+use crate::math::{Real, Vec2};
+use crate::particles::FaceSide;
+
+/// `cross(a, b) = a_x b_y − a_y b_x`.
+#[inline]
+pub fn cross(a: &Vec2, b: &Vec2) -> Real {
+    a.x * b.y - a.y * b.x
+}
+
+/// The left normal `(−d_y, d_x)` of a direction.
+#[inline]
+pub fn left_normal(d: &Vec2) -> Vec2 {
+    Vec2::new(-d.y, d.x)
+}
+
+/// Relative distance below which a point counts as lying on a crack line
+/// (as a fraction of the segment length). Points on a crack line — a Gauss
+/// point on a cell diagonal that the crack follows, an unsplit particle the
+/// path touches — belong to the left side of the path, by convention
+/// (left of the direction of growth); 1e-9 is far below any spacing ratio
+/// and far above round-off of reference coordinates.
+pub const ON_LINE_TOLERANCE: Real = 1e-9;
+
+/// Whether the sight line from evaluation point `x` to particle position
+/// `p` is blocked by the (already extended) crack segment `[a, b]`.
+///
+/// Blocked when `x` and `p` lie on opposite sides of the segment's line and
+/// the sight line meets the segment. Ties, by convention: a point `x` on
+/// the line counts as lying on its left; a particle `p` on the line (a tip
+/// particle, or a particle the path touches) is never blocked by that
+/// segment; a sight line that reaches the segment exactly at an end is
+/// blocked (the ends are extended beyond the split particles, so this only
+/// decides at the extension's tip).
+pub fn sight_line_blocked(a: &Vec2, b: &Vec2, x: &Vec2, p: &Vec2) -> bool {
+    let d = b - a;
+    let len2 = d.norm_squared();
+    if len2 == 0.0 {
+        return false;
+    }
+    let tol = ON_LINE_TOLERANCE * len2.sqrt();
+    let len = len2.sqrt();
+    let ox = cross(&d, &(x - a)) / len; // signed distance of x from the line
+    let op = cross(&d, &(p - a)) / len;
+    if op.abs() <= tol {
+        return false;
+    }
+    let x_left = ox > -tol;
+    let p_left = op > 0.0;
+    if x_left == p_left {
+        return false;
+    }
+    // Opposite sides: the sight line crosses the segment's line at one
+    // point; is that point within [a, b]?
+    let s = x - p;
+    let oa = cross(&s, &(a - p));
+    let ob = cross(&s, &(b - p));
+    oa * ob <= 0.0
+}
+
+/// Whether `x` lies on the left of a crack path that passes through
+/// `vertex` arriving along unit `incoming` and leaving along unit
+/// `outgoing` (left of the direction of growth). Points on the path count
+/// as left ([`ON_LINE_TOLERANCE`]).
+pub fn left_of_path(vertex: &Vec2, incoming: &Vec2, outgoing: &Vec2, x: &Vec2) -> bool {
+    let r = x - vertex;
+    let scale = r.norm().max(Real::MIN_POSITIVE);
+    let tol = ON_LINE_TOLERANCE * scale;
+    let l_in = cross(incoming, &r) > -tol;
+    let l_out = cross(outgoing, &r) > -tol;
+    if cross(incoming, outgoing) >= 0.0 {
+        // turning left (or straight): the left side is the convex wedge
+        l_in && l_out
+    } else {
+        // turning right: the left side is the reflex wedge
+        l_in || l_out
+    }
+}
+
+/// Whether a split particle with crack side `side` may contribute at `x`
+/// by the side rule alone (SPEC §9: "each split particle is visible only
+/// from its own side"). Beyond `side.reach` the rule does not apply.
+pub fn side_allows(side: &FaceSide, x: &Vec2) -> bool {
+    if (x - side.vertex).norm() > side.reach {
+        return true;
+    }
+    left_of_path(&side.vertex, &side.incoming, &side.outgoing, x) == side.left
+}
+
+/// Angles of the two sectors a crack path makes at a vertex it passes
+/// through: `(φ_left, φ_right)`, rad, `φ_left + φ_right = 2π`. A path
+/// turning left by `α` leaves `φ_left = π − α` ([RL10, Eqs. (4.16)–(4.19)]).
+pub fn sector_angles(incoming: &Vec2, outgoing: &Vec2) -> (Real, Real) {
+    let alpha = cross(incoming, outgoing).atan2(incoming.dot(outgoing));
+    let pi = std::f64::consts::PI;
+    (pi - alpha, pi + alpha)
+}
+
+/// Unit bisector of the left sector at a vertex (the direction in which the
+/// left particle of a split is offset); the right one is its negative.
+pub fn left_bisector(incoming: &Vec2, outgoing: &Vec2) -> Vec2 {
+    let b = left_normal(incoming) + left_normal(outgoing);
+    let n = b.norm();
+    if n > 1e-12 {
+        b / n
+    } else {
+        left_normal(incoming)
+    }
+}
+
+/// The widest empty angular sector around a point, given the directions to
+/// its neighbours: `(width, start)` with the sector running counter-
+/// clockwise from angle `start` over `width` (rad). With no neighbours the
+/// whole circle is empty.
+pub fn widest_empty_sector(directions: &[Vec2]) -> (Real, Real) {
+    let two_pi = 2.0 * std::f64::consts::PI;
+    if directions.is_empty() {
+        return (two_pi, 0.0);
+    }
+    let mut ang: Vec<Real> = directions.iter().map(|d| d.y.atan2(d.x)).collect();
+    ang.sort_by(|a, b| a.partial_cmp(b).expect("finite angles"));
+    let mut best = (ang[0] + two_pi - ang[ang.len() - 1], ang[ang.len() - 1]);
+    for w in ang.windows(2) {
+        if w[1] - w[0] > best.0 {
+            best = (w[1] - w[0], w[0]);
+        }
+    }
+    best
+}
+
+/// Whether direction `d` points into the sector `(width, start)`.
+pub fn sector_contains(sector: (Real, Real), d: &Vec2) -> bool {
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let a = (d.y.atan2(d.x) - sector.1).rem_euclid(two_pi);
+    a <= sector.0
+}
+
+/// Distance from point `x` to segment `[a, b]`.
+pub fn point_segment_distance(a: &Vec2, b: &Vec2, x: &Vec2) -> Real {
+    let d = b - a;
+    let l2 = d.norm_squared();
+    if l2 == 0.0 {
+        return (x - a).norm();
+    }
+    let t = ((x - a).dot(&d) / l2).clamp(0.0, 1.0);
+    (a + d * t - x).norm()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    fn v(x: Real, y: Real) -> Vec2 {
+        Vec2::new(x, y)
+    }
+
+    #[test]
+    fn sight_lines_across_a_segment_are_blocked_along_it_not() {
+        let (a, b) = (v(0.0, 0.0), v(1.0, 0.0));
+        assert!(sight_line_blocked(&a, &b, &v(0.5, 1.0), &v(0.4, -1.0)));
+        assert!(!sight_line_blocked(&a, &b, &v(0.5, 1.0), &v(0.4, 0.5)));
+        // passes beyond the end
+        assert!(!sight_line_blocked(&a, &b, &v(1.5, 1.0), &v(1.5, -1.0)));
+        // x on the line belongs to the left (y > 0 for a segment along +x)
+        assert!(!sight_line_blocked(&a, &b, &v(0.5, 0.0), &v(0.5, 1.0)));
+        assert!(sight_line_blocked(&a, &b, &v(0.5, 0.0), &v(0.5, -1.0)));
+        // a particle on the line is not blocked
+        assert!(!sight_line_blocked(&a, &b, &v(0.5, -1.0), &v(1.0, 0.0)));
+    }
+
+    #[test]
+    fn side_of_a_kinked_path() {
+        let c = v(0.0, 0.0);
+        let din = v(0.0, -1.0);
+        // turning left (towards +x when going down): outgoing (1, -1)/sqrt2
+        let dout = v(1.0, -1.0) / 2f64.sqrt();
+        assert!(cross(&din, &dout) > 0.0);
+        // left of a downward path is +x; the left wedge lies between up (behind) and dout
+        assert!(left_of_path(&c, &din, &dout, &v(1.0, 0.5)));
+        assert!(!left_of_path(&c, &din, &dout, &v(1.0, -2.0)));
+        assert!(!left_of_path(&c, &din, &dout, &v(-1.0, 0.0)));
+        let (l, r) = sector_angles(&din, &dout);
+        assert!((l - 0.75 * PI).abs() < 1e-12 && (r - 1.25 * PI).abs() < 1e-12);
+        let b = left_bisector(&din, &dout);
+        assert!(left_of_path(&c, &din, &dout, &(b * 1e-3)));
+        assert!(!left_of_path(&c, &din, &dout, &(-b * 1e-3)));
+        // straight path: halves
+        let (l, r) = sector_angles(&din, &din);
+        assert!((l - PI).abs() < 1e-15 && (r - PI).abs() < 1e-15);
+    }
+
+    #[test]
+    fn empty_sector_of_a_surface_point_and_an_interior_point() {
+        let lattice: Vec<Vec2> = (-2..=2)
+            .flat_map(|i| (-2..=2).map(move |j| v(i as Real, j as Real)))
+            .filter(|p| p.norm() > 0.0 && p.norm() < 2.5)
+            .collect();
+        let (w, _) = widest_empty_sector(&lattice);
+        assert!(w < 0.5 * PI + 1e-12);
+        let half: Vec<Vec2> = lattice.iter().cloned().filter(|p| p.y <= 0.0).collect();
+        let s = widest_empty_sector(&half);
+        assert!((s.0 - PI).abs() < 1e-12);
+        assert!(sector_contains(s, &v(0.3, 1.0)));
+        assert!(!sector_contains(s, &v(0.3, -1.0)));
+    }
+}

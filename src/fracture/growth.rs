@@ -1,0 +1,830 @@
+//! The crack-growth stage (SPEC §9, [RL10, §4]): criteria, nucleation,
+//! propagation, arrest, particle splitting and the local rebuild of the
+//! shape tables and lumped masses. See the module doc of
+//! [`crate::fracture`] for the choices and deviations.
+
+use super::geometry::{
+    left_bisector, left_normal, point_segment_distance, sector_angles, sector_contains,
+    widest_empty_sector,
+};
+use super::rows::{rebuild_rows_with_fallback, Basis};
+use super::visibility::{CrackSegments, CrackVisibility};
+use super::{Criterion, FractureError, FractureParameters};
+use crate::geometry::GeometryMode;
+use crate::material::Constitutive;
+use crate::math::{Real, Vec2};
+use crate::model::{Gather, Model};
+use crate::neighbors::CellGrid;
+use crate::particles::{FaceSide, ParticleFlags};
+use std::collections::BTreeMap;
+
+/// Crack segments are extended by this many offsets `δ` beyond each end
+/// that is not a growing tip.
+pub const EXTENSION_PER_OFFSET: Real = 5.0;
+
+/// A crack segment that starts or ends on the outer surface makes at most
+/// this angle with the surface normal, degrees (module doc).
+pub const MAX_SURFACE_OBLIQUITY: Real = 40.0;
+
+/// Smallest lumped mass of a re-lumped particle, as a fraction of its
+/// nodal mass `ρ ΔV_I` (see the module doc of [`crate::fracture`]).
+pub const MASS_FLOOR: Real = 0.5;
+
+/// A segment may not pass within this fraction of a particle's spacing of
+/// a particle it does not end at.
+const PASS_OVER_FRACTION: Real = 0.1;
+
+/// Angle between two non-zero vectors, rad.
+fn angle(a: &Vec2, b: &Vec2) -> Real {
+    (a.dot(b) / (a.norm() * b.norm())).clamp(-1.0, 1.0).acos()
+}
+
+/// What happened to a crack.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EventKind {
+    Nucleate,
+    Propagate,
+    Arrest,
+}
+
+impl EventKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            EventKind::Nucleate => "nucleate",
+            EventKind::Propagate => "propagate",
+            EventKind::Arrest => "arrest",
+        }
+    }
+}
+
+/// One entry of the crack log.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CrackEvent {
+    /// Simulated time, s.
+    pub time: Real,
+    pub step: u64,
+    pub crack: usize,
+    pub kind: EventKind,
+    /// Particles involved: the split particle (left child), the new right
+    /// child, and for nucleation and propagation the new tip.
+    pub particles: Vec<usize>,
+    /// Criterion value of the deciding particle (the new tip; the split
+    /// tip at arrest).
+    pub value: Real,
+}
+
+/// A vertex of a crack path.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CrackVertex {
+    /// Reference position, m.
+    pub x0: Vec2,
+    /// `(left, right)` children if a particle was split here; `None` at a
+    /// growing tip and at the end point past the surface after arrest.
+    pub faces: Option<(u32, u32)>,
+}
+
+/// A crack: a polyline in the reference configuration whose tip is a
+/// particle while it grows.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Crack {
+    pub id: usize,
+    pub vertices: Vec<CrackVertex>,
+    /// Tip particle while growing.
+    pub tip: Option<usize>,
+    /// Split offset δ of this crack, m.
+    pub offset: Real,
+    /// Nucleation time, s, and step.
+    pub nucleated: (Real, u64),
+    /// Arrest time, s, and step.
+    pub arrested: Option<(Real, u64)>,
+}
+
+impl Crack {
+    /// Unit direction of the last segment.
+    pub fn direction(&self) -> Vec2 {
+        let n = self.vertices.len();
+        (self.vertices[n - 1].x0 - self.vertices[n - 2].x0).normalize()
+    }
+
+    /// Whether the crack still grows.
+    pub fn growing(&self) -> bool {
+        self.tip.is_some()
+    }
+
+    /// Opaque segments of this crack, extended by `EXTENSION_PER_OFFSET δ`
+    /// at every end except a growing tip.
+    pub fn segments(&self) -> Vec<(Vec2, Vec2)> {
+        let ext = EXTENSION_PER_OFFSET * self.offset;
+        let n = self.vertices.len();
+        (0..n - 1)
+            .map(|k| {
+                let (a, b) = (self.vertices[k].x0, self.vertices[k + 1].x0);
+                let d = (b - a).normalize();
+                let b_ext = if k + 2 == n && self.growing() {
+                    0.0
+                } else {
+                    ext
+                };
+                (a - d * ext, b + d * b_ext)
+            })
+            .collect()
+    }
+
+    /// The two faces in the current configuration (`x = X + u(X)`, with
+    /// the children's physical displacements): `[left, right]` polylines.
+    /// A growing tip closes both; the end point past the surface moves with
+    /// the last split vertex.
+    pub fn face_polylines(&self, model: &Model) -> [Vec<Vec2>; 2] {
+        let u = |i: usize| model.particle_shape.interpolate(i, &model.particles.u);
+        let mut faces = [Vec::new(), Vec::new()];
+        let mut last = (Vec2::zeros(), Vec2::zeros());
+        for v in &self.vertices {
+            let (l, r) = match v.faces {
+                Some((l, r)) => (u(l as usize), u(r as usize)),
+                None => match self.tip {
+                    Some(t) if model.particles.x0[t] == v.x0 => (u(t), u(t)),
+                    _ => last,
+                },
+            };
+            last = (l, r);
+            faces[0].push(v.x0 + l);
+            faces[1].push(v.x0 + r);
+        }
+        faces
+    }
+}
+
+/// The crack-growth stage: the cracks, their log, and the opaque segments.
+#[derive(Clone, Debug)]
+pub struct CrackGrowth {
+    pub params: FractureParameters,
+    pub cracks: Vec<Crack>,
+    /// Every event, in order.
+    pub events: Vec<CrackEvent>,
+    segments: CrackSegments,
+    /// Reference positions binned for the circle searches (rebuilt when
+    /// particles move or are added).
+    grid: Option<CellGrid>,
+    /// Quadrature rows built with a reduced basis (too few visible
+    /// particles next to a crack; [`super::rows`]).
+    pub reduced_quadrature_rows: BTreeMap<usize, Basis>,
+    /// Particle rows built with a reduced basis.
+    pub reduced_particle_rows: BTreeMap<usize, Basis>,
+}
+
+/// A split to perform at a crack vertex.
+struct Split {
+    parent: usize,
+    vertex: Vec2,
+    incoming: Vec2,
+    outgoing: Vec2,
+    reach: Real,
+    offset: Real,
+}
+
+impl CrackGrowth {
+    pub fn new(params: FractureParameters) -> Self {
+        CrackGrowth {
+            params,
+            cracks: Vec::new(),
+            events: Vec::new(),
+            segments: CrackSegments::default(),
+            grid: None,
+            reduced_quadrature_rows: BTreeMap::new(),
+            reduced_particle_rows: BTreeMap::new(),
+        }
+    }
+
+    /// The opaque segments of all cracks.
+    pub fn segments(&self) -> &CrackSegments {
+        &self.segments
+    }
+
+    /// The visibility of the current crack set for `model`'s particles.
+    pub fn visibility<'a>(&'a self, model: &'a Model) -> CrackVisibility<'a> {
+        CrackVisibility {
+            segments: &self.segments,
+            x0: &model.particles.x0,
+            face_side: &model.particles.face_side,
+        }
+    }
+
+    /// Per-particle criterion value: the lumped projection of the
+    /// quadrature field (module doc of [`crate::fracture`]).
+    pub fn criterion_value(&self, model: &Model, i: usize) -> Real {
+        let col = match self.params.criterion {
+            Criterion::EffectiveStrain => &model.quad.eps_p,
+            Criterion::Damage => &model.quad.damage,
+            Criterion::None => return 0.0,
+        };
+        let (mut acc, mut wsum) = (0.0, 0.0);
+        for j in model.gather.range(i) {
+            let (k, q) = (
+                model.gather.entry[j] as usize,
+                model.gather.point[j] as usize,
+            );
+            let w = model.qp_shape.value[k] * model.quad.weight[q];
+            acc += w * col[q];
+            wsum += w;
+        }
+        if wsum != 0.0 {
+            acc / wsum
+        } else {
+            0.0
+        }
+    }
+
+    /// Time of plug separation: when the through-cracks that cut a plug
+    /// out have all arrested — two in plane strain (one on each side of
+    /// the projectile), one in axisymmetry (a ring crack).
+    pub fn separation_time(&self, mode: GeometryMode) -> Option<Real> {
+        let needed = match mode {
+            GeometryMode::PlaneStrain => 2,
+            GeometryMode::Axisymmetric => 1,
+        };
+        let mut t: Vec<Real> = self
+            .cracks
+            .iter()
+            .filter_map(|c| c.arrested.map(|a| a.0))
+            .collect();
+        t.sort_by(|a, b| a.partial_cmp(b).expect("finite times"));
+        t.get(needed - 1).copied()
+    }
+
+    /// One crack-growth stage at time `time` (after step `step`): each
+    /// growing crack arrests or advances by at most one particle, then new
+    /// cracks nucleate. Returns the new crack-face particles (for the
+    /// contact slave set).
+    pub fn grow(
+        &mut self,
+        model: &mut Model,
+        time: Real,
+        step: u64,
+    ) -> Result<Vec<usize>, FractureError> {
+        let Some(critical) = self.params.critical_value() else {
+            return Ok(Vec::new());
+        };
+        let mut faces = Vec::new();
+        for c in 0..self.cracks.len() {
+            let Some(tip) = self.cracks[c].tip else {
+                continue;
+            };
+            self.ensure_grid(model);
+            let d = self.cracks[c].direction();
+            let xt = model.particles.x0[tip];
+            let mean = (xt - self.cracks[c].vertices[0].x0).normalize();
+            let circle = self.circle(model, tip);
+            let dirs: Vec<Vec2> = circle.iter().map(|&j| model.particles.x0[j] - xt).collect();
+            let sector = widest_empty_sector(&dirs);
+            if sector.0 > self.params.fan_angle.to_radians() && sector_contains(sector, &d) {
+                faces.extend(self.arrest(model, c, time, step)?);
+                continue;
+            }
+            let half_fan = 0.5 * self.params.fan_angle.to_radians();
+            let mut best: Option<(Real, usize)> = None;
+            for &j in &circle {
+                if model.particles.flags[j].has(ParticleFlags::CRACK_FACE) {
+                    continue;
+                }
+                let r = model.particles.x0[j] - xt;
+                if r.norm() == 0.0 || angle(&r, &d) > half_fan || angle(&r, &mean) > half_fan {
+                    continue;
+                }
+                let value = self.criterion_value(model, j);
+                if value < critical || best.is_some_and(|(bv, _)| bv >= value) {
+                    continue;
+                }
+                if self.passes_over(model, tip, j) || self.blocked_from_tip(model, c, j) {
+                    continue;
+                }
+                if let Some(n) = self.outward_normal(model, j) {
+                    if angle(&r, &n) > MAX_SURFACE_OBLIQUITY.to_radians() {
+                        continue;
+                    }
+                }
+                best = Some((value, j));
+            }
+            if let Some((value, j)) = best {
+                faces.extend(self.propagate(model, c, j, value, time, step)?);
+            }
+        }
+        faces.extend(self.nucleate(model, critical, time, step)?);
+        Ok(faces)
+    }
+
+    /// Insert a crack along the particles `path` (first: a surface
+    /// particle; then each next tip) regardless of the criterion, arresting
+    /// it at the end if `arrest` (the last particle on the far surface).
+    /// For pre-cracked specimens and tests. Returns the crack id and the
+    /// new crack-face particles.
+    pub fn insert_crack(
+        &mut self,
+        model: &mut Model,
+        path: &[usize],
+        arrest: bool,
+    ) -> Result<(usize, Vec<usize>), FractureError> {
+        if path.len() < 2 {
+            return Err(FractureError::InvalidPath(
+                "needs at least two particles".into(),
+            ));
+        }
+        let n = model.particles.len();
+        if let Some(&bad) = path.iter().find(|&&i| i >= n) {
+            return Err(FractureError::InvalidPath(format!(
+                "particle {bad} does not exist ({n} particles)"
+            )));
+        }
+        if path
+            .iter()
+            .any(|&i| model.particles.flags[i].has(ParticleFlags::CRACK_FACE))
+        {
+            return Err(FractureError::InvalidPath(
+                "a particle of the path is already on a crack face".into(),
+            ));
+        }
+        let c = self.cracks.len();
+        let mut faces = self.start_crack(model, path[0], path[1], Real::NAN, 0.0, 0)?;
+        for &j in &path[2..] {
+            faces.extend(self.propagate(model, c, j, Real::NAN, 0.0, 0)?);
+        }
+        if arrest {
+            faces.extend(self.arrest(model, c, 0.0, 0)?);
+        }
+        Ok((c, faces))
+    }
+
+    fn ensure_grid(&mut self, model: &Model) {
+        if self.grid.is_none() {
+            let p = &model.particles;
+            let reach = p.spacing.iter().cloned().fold(0.0, Real::max) * self.params.radius_factor;
+            self.grid = Some(CellGrid::new(&p.x0, reach.max(Real::MIN_POSITIVE)));
+        }
+    }
+
+    /// Particles of `i`'s body within `R_i` of `X_i` (excluding `i`), ascending.
+    fn circle(&self, model: &Model, i: usize) -> Vec<usize> {
+        let p = &model.particles;
+        let r = self.params.radius_factor * p.spacing[i];
+        let mut out = Vec::new();
+        self.grid
+            .as_ref()
+            .expect("grid built")
+            .for_each_candidate(&p.x0[i], r, |j| {
+                if j != i && p.body[j] == p.body[i] && (p.x0[j] - p.x0[i]).norm() <= r {
+                    out.push(j);
+                }
+            });
+        out.sort_unstable();
+        out
+    }
+
+    /// Outward normal of the outer surface at particle `i` (the bisector of
+    /// the empty sector wider than `θ_c` in its circle), if it is on one.
+    fn outward_normal(&self, model: &Model, i: usize) -> Option<Vec2> {
+        let xi = model.particles.x0[i];
+        let dirs: Vec<Vec2> = self
+            .circle(model, i)
+            .iter()
+            .map(|&j| model.particles.x0[j] - xi)
+            .collect();
+        let (width, start) = widest_empty_sector(&dirs);
+        (width > self.params.fan_angle.to_radians()).then(|| {
+            let a = start + 0.5 * width;
+            Vec2::new(a.cos(), a.sin())
+        })
+    }
+
+    /// Whether segment `X_i X_j` passes over a third particle.
+    fn passes_over(&self, model: &Model, i: usize, j: usize) -> bool {
+        let p = &model.particles;
+        let (a, b) = (p.x0[i], p.x0[j]);
+        let reach = (b - a).norm() + p.spacing[i];
+        let mut hit = false;
+        self.grid.as_ref().expect("grid built").for_each_candidate(
+            &a,
+            reach.min(self.grid_cell(model)),
+            |k| {
+                if k != i
+                    && k != j
+                    && point_segment_distance(&a, &b, &p.x0[k]) < PASS_OVER_FRACTION * p.spacing[k]
+                {
+                    hit = true;
+                }
+            },
+        );
+        hit
+    }
+
+    fn grid_cell(&self, model: &Model) -> Real {
+        model.particles.spacing.iter().cloned().fold(0.0, Real::max) * self.params.radius_factor
+    }
+
+    /// Whether another crack's segment (or an earlier segment of this one)
+    /// lies between the tip of crack `c` and particle `j`.
+    fn blocked_from_tip(&self, model: &Model, c: usize, j: usize) -> bool {
+        let tip = self.cracks[c].tip.expect("growing");
+        let (xt, xj) = (model.particles.x0[tip], model.particles.x0[j]);
+        // The crack's own last segment ends at the tip: start the sight
+        // line a hair ahead of it.
+        let start = xt + (xj - xt) * 1e-6;
+        self.segments.blocked(&start, &xj)
+    }
+
+    fn nucleate(
+        &mut self,
+        model: &mut Model,
+        critical: Real,
+        time: Real,
+        step: u64,
+    ) -> Result<Vec<usize>, FractureError> {
+        let mut cores: Vec<(Real, usize)> = (0..model.particles.len())
+            .filter(|&i| {
+                let f = model.particles.flags[i];
+                f.has(ParticleFlags::SLAVE) && !f.has(ParticleFlags::CRACK_FACE)
+            })
+            .map(|i| (self.criterion_value(model, i), i))
+            .filter(|&(v, _)| v >= critical)
+            .collect();
+        if cores.is_empty() {
+            return Ok(Vec::new());
+        }
+        cores.sort_by(|a, b| b.0.partial_cmp(&a.0).expect("finite").then(a.1.cmp(&b.1)));
+        let mut faces = Vec::new();
+        for (_, i) in cores {
+            // the core may have been re-indexed by nothing (splits append), but
+            // a split in this loop may have put it on a face
+            if model.particles.flags[i].has(ParticleFlags::CRACK_FACE) {
+                continue;
+            }
+            let xi = model.particles.x0[i];
+            let exclusion = self.params.nucleation_distance_factor * model.particles.spacing[i];
+            let near = self.cracks.iter().any(|c| {
+                c.vertices
+                    .windows(2)
+                    .any(|w| point_segment_distance(&w[0].x0, &w[1].x0, &xi) < exclusion)
+            });
+            if near {
+                continue;
+            }
+            self.ensure_grid(model);
+            let mut best: Option<(Real, usize)> = None;
+            for j in self.circle(model, i) {
+                let f = model.particles.flags[j];
+                if f.has(ParticleFlags::CRACK_FACE)
+                    || f.has(ParticleFlags::SLAVE)
+                    || f.has(ParticleFlags::SURFACE)
+                {
+                    continue;
+                }
+                let value = self.criterion_value(model, j);
+                if value < critical || best.is_some_and(|(bv, _)| bv >= value) {
+                    continue;
+                }
+                if self.passes_over(model, i, j)
+                    || self.segments.blocked(&xi, &model.particles.x0[j])
+                {
+                    continue;
+                }
+                let inward = self.outward_normal(model, i).map(|n| -n);
+                let oblique = MAX_SURFACE_OBLIQUITY.to_radians();
+                if inward.is_some_and(|n| angle(&(model.particles.x0[j] - xi), &n) > oblique) {
+                    continue;
+                }
+                best = Some((value, j));
+            }
+            if let Some((value, j)) = best {
+                faces.extend(self.start_crack(model, i, j, value, time, step)?);
+            }
+        }
+        Ok(faces)
+    }
+
+    /// Nucleation: split core `i` in halves normal to `X_i X_j`; `j` is the tip.
+    fn start_crack(
+        &mut self,
+        model: &mut Model,
+        i: usize,
+        j: usize,
+        value: Real,
+        time: Real,
+        step: u64,
+    ) -> Result<Vec<usize>, FractureError> {
+        let (xi, xj) = (model.particles.x0[i], model.particles.x0[j]);
+        let d = (xj - xi).normalize();
+        let offset = self.params.offset_ratio * model.particles.spacing[i];
+        let id = self.cracks.len();
+        self.cracks.push(Crack {
+            id,
+            vertices: vec![
+                CrackVertex {
+                    x0: xi,
+                    faces: None,
+                },
+                CrackVertex {
+                    x0: xj,
+                    faces: None,
+                },
+            ],
+            tip: Some(j),
+            offset,
+            nucleated: (time, step),
+            arrested: None,
+        });
+        let split = Split {
+            parent: i,
+            vertex: xi,
+            incoming: d,
+            outgoing: d,
+            reach: (xj - xi).norm(),
+            offset,
+        };
+        let (l, r) = self.split(model, id, split)?;
+        self.cracks[id].vertices[0].faces = Some((l as u32, r as u32));
+        self.events.push(CrackEvent {
+            time,
+            step,
+            crack: id,
+            kind: EventKind::Nucleate,
+            particles: vec![l, r, j],
+            value,
+        });
+        Ok(vec![l, r])
+    }
+
+    /// Propagation: split the tip of crack `c` by the sector angles, `j` is the new tip.
+    fn propagate(
+        &mut self,
+        model: &mut Model,
+        c: usize,
+        j: usize,
+        value: Real,
+        time: Real,
+        step: u64,
+    ) -> Result<Vec<usize>, FractureError> {
+        let tip = self.cracks[c].tip.expect("growing");
+        let (xt, xj) = (model.particles.x0[tip], model.particles.x0[j]);
+        let incoming = self.cracks[c].direction();
+        let outgoing = (xj - xt).normalize();
+        let n = self.cracks[c].vertices.len();
+        let last_len = (xt - self.cracks[c].vertices[n - 2].x0).norm();
+        self.cracks[c].vertices.push(CrackVertex {
+            x0: xj,
+            faces: None,
+        });
+        self.cracks[c].tip = Some(j);
+        let split = Split {
+            parent: tip,
+            vertex: xt,
+            incoming,
+            outgoing,
+            reach: last_len.min((xj - xt).norm()),
+            offset: self.cracks[c].offset,
+        };
+        let (l, r) = self.split(model, c, split)?;
+        self.cracks[c].vertices[n - 1].faces = Some((l as u32, r as u32));
+        self.events.push(CrackEvent {
+            time,
+            step,
+            crack: c,
+            kind: EventKind::Propagate,
+            particles: vec![l, r, j],
+            value,
+        });
+        Ok(vec![l, r])
+    }
+
+    /// Arrest: split the tip in halves, extend the path by δ, stop.
+    fn arrest(
+        &mut self,
+        model: &mut Model,
+        c: usize,
+        time: Real,
+        step: u64,
+    ) -> Result<Vec<usize>, FractureError> {
+        let tip = self.cracks[c].tip.expect("growing");
+        let value = self.criterion_value(model, tip);
+        let xt = model.particles.x0[tip];
+        let d = self.cracks[c].direction();
+        let n = self.cracks[c].vertices.len();
+        let last_len = (xt - self.cracks[c].vertices[n - 2].x0).norm();
+        let offset = self.cracks[c].offset;
+        self.cracks[c].vertices.push(CrackVertex {
+            x0: xt + d * offset,
+            faces: None,
+        });
+        self.cracks[c].tip = None;
+        self.cracks[c].arrested = Some((time, step));
+        let split = Split {
+            parent: tip,
+            vertex: xt,
+            incoming: d,
+            outgoing: d,
+            reach: last_len,
+            offset,
+        };
+        let (l, r) = self.split(model, c, split)?;
+        self.cracks[c].vertices[n - 1].faces = Some((l as u32, r as u32));
+        self.events.push(CrackEvent {
+            time,
+            step,
+            crack: c,
+            kind: EventKind::Arrest,
+            particles: vec![l, r],
+            value,
+        });
+        Ok(vec![l, r])
+    }
+
+    /// Split a particle at a crack vertex and rebuild what the change
+    /// touches. The crack's path must already hold its new vertices.
+    fn split(
+        &mut self,
+        model: &mut Model,
+        crack: usize,
+        s: Split,
+    ) -> Result<(usize, usize), FractureError> {
+        let momentum = model.particles.momentum();
+        let (phi_l, phi_r) = sector_angles(&s.incoming, &s.outgoing);
+        let two_pi = 2.0 * std::f64::consts::PI;
+        let (fl, fr) = (phi_l / two_pi, phi_r / two_pi);
+        let b = left_bisector(&s.incoming, &s.outgoing);
+        let p = &mut model.particles;
+        let old_x = p.x0[s.parent];
+        let l = s.parent;
+        let r = p.split(l);
+        let side = |left: bool| FaceSide {
+            vertex: s.vertex,
+            incoming: s.incoming,
+            outgoing: s.outgoing,
+            left,
+            reach: s.reach,
+        };
+        for (k, f, sign, left) in [(l, fl, 1.0, true), (r, fr, -1.0, false)] {
+            p.x0[k] = s.vertex + b * (sign * s.offset);
+            p.volume[k] *= f;
+            p.mass[k] *= f;
+            p.f_ext[k] *= f;
+            p.a[k] = Vec2::zeros();
+            p.flags[k].set(ParticleFlags::CRACK_FACE | ParticleFlags::SLAVE);
+            p.face_side[k] = Some(side(left));
+        }
+        debug_assert!(left_normal(&s.incoming).dot(&b) > 0.0 || s.incoming != s.outgoing);
+        self.refresh_segments(model);
+        self.grid = None;
+        // Region whose rows can change: the segments at the vertex (the new
+        // one whole, up to its far end within R; the old one's extension)
+        // and the old and new particle positions, grown by the largest
+        // support in `rebuild_local` (a sight line lies inside the window
+        // of the particle it ends at).
+        let radius = self.params.radius_factor * model.particles.spacing[l] * 1.01
+            + 2.0 * EXTENSION_PER_OFFSET * s.offset;
+        let mut lo = old_x.inf(&s.vertex);
+        let mut hi = old_x.sup(&s.vertex);
+        for (a, bb) in self.cracks[crack].segments() {
+            for x in [a, bb] {
+                if (x - s.vertex).norm() <= radius {
+                    lo = lo.inf(&x);
+                    hi = hi.sup(&x);
+                }
+            }
+        }
+        self.rebuild_local(model, lo, hi, momentum)
+            .map_err(|source| FractureError::Shape {
+                crack,
+                particle: l,
+                source,
+            })?;
+        Ok((l, r))
+    }
+
+    fn refresh_segments(&mut self, model: &Model) {
+        let all: Vec<(Vec2, Vec2)> = self.cracks.iter().flat_map(|c| c.segments()).collect();
+        let cell = model.particles.support.iter().cloned().fold(0.0, Real::max);
+        self.segments = CrackSegments::new(all, cell);
+    }
+
+    /// Recompute the quadrature and particle rows with evaluation points in
+    /// the box `[lo, hi]` grown by the largest support, the gather, the
+    /// lumped masses of the particles in the old or new rows, and restore
+    /// the linear momentum `momentum` (module doc).
+    fn rebuild_local(
+        &mut self,
+        model: &mut Model,
+        lo: Vec2,
+        hi: Vec2,
+        momentum: Vec2,
+    ) -> Result<(), crate::shape::ShapeError> {
+        let grow = model.particles.support.iter().cloned().fold(0.0, Real::max) * (1.0 + 1e-9);
+        let (lo, hi) = (lo - Vec2::repeat(grow), hi + Vec2::repeat(grow));
+        let inside = |x: &Vec2| x.x >= lo.x && x.x <= hi.x && x.y >= lo.y && x.y <= hi.y;
+        let n = model.particles.len();
+        let rows_q: Vec<usize> = (0..model.quad.len())
+            .filter(|&q| inside(&model.quad.x0[q]))
+            .collect();
+        let ps = &mut model.particle_shape;
+        while ps.rows() < n {
+            let end = *ps.offsets.last().expect("offsets start at 0");
+            ps.offsets.push(end);
+        }
+        let rows_p: Vec<usize> = (0..n).filter(|&i| inside(&model.particles.x0[i])).collect();
+        let mut touched = vec![false; n];
+        for &q in &rows_q {
+            for k in model.qp_shape.range(q) {
+                touched[model.qp_shape.index[k] as usize] = true;
+            }
+        }
+        let p = &model.particles;
+        let vis = CrackVisibility {
+            segments: &self.segments,
+            x0: &p.x0,
+            face_side: &p.face_side,
+        };
+        let mut qp_shape = std::mem::take(&mut model.qp_shape);
+        let mut particle_shape = std::mem::take(&mut model.particle_shape);
+        let r1 = rebuild_rows_with_fallback(
+            &mut qp_shape,
+            &rows_q,
+            &model.quad.x0,
+            &p.x0,
+            &p.support,
+            &p.volume,
+            &vis,
+        );
+        let r2 = rebuild_rows_with_fallback(
+            &mut particle_shape,
+            &rows_p,
+            &p.x0,
+            &p.x0,
+            &p.support,
+            &p.volume,
+            &vis,
+        );
+        model.qp_shape = qp_shape;
+        model.particle_shape = particle_shape;
+        for (rows, reduced, map) in [
+            (&rows_q, r1?, &mut self.reduced_quadrature_rows),
+            (&rows_p, r2?, &mut self.reduced_particle_rows),
+        ] {
+            for r in rows {
+                map.remove(r);
+            }
+            map.extend(reduced);
+        }
+        for &q in &rows_q {
+            for k in model.qp_shape.range(q) {
+                touched[model.qp_shape.index[k] as usize] = true;
+            }
+        }
+        model.gather = Gather::new(&model.qp_shape, n);
+        let touched: Vec<usize> = (0..n).filter(|&i| touched[i]).collect();
+        let before: Real = touched.iter().map(|&i| model.particles.mass[i]).sum();
+        let mut floored = Vec::new();
+        for &i in &touched {
+            let m = model.lumped_mass(i);
+            let rho = model.materials[model.particles.body[i] as usize].density();
+            let floor = MASS_FLOOR * rho * model.particles.volume[i];
+            if m < floor {
+                floored.push(i);
+            }
+            model.particles.mass[i] = m.max(floor);
+        }
+        if !floored.is_empty() {
+            // Take the floor's extra mass from the other re-lumped particles,
+            // in proportion to their masses: the total stays exact.
+            let p = &mut model.particles;
+            let after: Real = touched.iter().map(|&i| p.mass[i]).sum();
+            let rest: Real = touched
+                .iter()
+                .filter(|i| !floored.contains(i))
+                .map(|&i| p.mass[i])
+                .sum();
+            let scale = 1.0 - (after - before) / rest;
+            for &i in touched.iter().filter(|i| !floored.contains(i)) {
+                p.mass[i] *= scale;
+            }
+        }
+        // Momentum: one uniform shift of the re-lumped particles' free components.
+        let p = &mut model.particles;
+        let dp = momentum - p.momentum();
+        for c in 0..2 {
+            let fix = if c == 0 {
+                ParticleFlags::FIX_X
+            } else {
+                ParticleFlags::FIX_Y
+            };
+            let free: Vec<usize> = touched
+                .iter()
+                .cloned()
+                .filter(|&i| !p.flags[i].has(fix))
+                .collect();
+            let m: Real = free.iter().map(|&i| p.mass[i]).sum();
+            if m > 0.0 {
+                let shift = dp[c] / m;
+                for &i in &free {
+                    p.v[i][c] += shift;
+                }
+            }
+        }
+        Ok(())
+    }
+}

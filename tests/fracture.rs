@@ -1,0 +1,562 @@
+//! Crack nucleation, propagation and arrest by particle splitting and the
+//! visibility criterion (SPEC §9, [RL10, §4]).
+//!
+//! The invariants (mass, momentum, reproduction, no support across a crack)
+//! are checked after every split with their own code, not the solver's.
+
+use plugsim::case::Case;
+use plugsim::contact::{SlaveSet, SurfaceDetection};
+use plugsim::discretize::RectangleGrid;
+use plugsim::fracture::rows::Basis;
+use plugsim::fracture::{CrackGrowth, Criterion, EventKind, FractureParameters};
+use plugsim::geometry::GeometryMode;
+use plugsim::material::{Elastic, Material};
+use plugsim::math::{Real, Vec2};
+use plugsim::model::{BodySetup, Model};
+use plugsim::particles::ParticleFlags;
+use plugsim::shape::ShapeTable;
+use plugsim::step::{Simulation, TimeStepRule};
+
+const H: Real = 0.5e-3;
+
+fn steel() -> Elastic {
+    Elastic {
+        density: 7850.0,
+        youngs_modulus: 200e9,
+        poisson_ratio: 0.3,
+        room_temperature: 293.0,
+        thermal: None,
+    }
+}
+
+/// A uniform `nx × ny` lattice of spacing `H` on `[0, (nx−1)H] × [0, (ny−1)H]`;
+/// particle `(i, j)` is `j nx + i`. Surface particles are contact slaves.
+fn plate(nx: usize, ny: usize) -> Model {
+    let grid = RectangleGrid {
+        x_min: 0.0,
+        x_max: (nx - 1) as Real * H,
+        y_min: 0.0,
+        y_max: (ny - 1) as Real * H,
+        layers: ny,
+        refine_at: Some(0.0),
+        fine_half_width: 0.0,
+        fine_spacing: None,
+        growth: 1.0,
+        coarse_spacing: None,
+        support_factor: 2.0,
+        gauss: 2,
+    };
+    let body = BodySetup {
+        name: "plate".into(),
+        grid,
+        material: Material::Elastic(steel()),
+        initial_velocity: vec![],
+        supports: vec![],
+    };
+    let mut m = Model::build(GeometryMode::PlaneStrain, &[body]).unwrap();
+    assert_eq!(m.particles.len(), nx * ny);
+    let slaves = SlaveSet::detect(
+        &m.particles.x0,
+        &m.particles.spacing,
+        &SurfaceDetection::default(),
+    )
+    .unwrap();
+    slaves.mark_flags(&mut m.particles.flags).unwrap();
+    m
+}
+
+fn params(criterion: Criterion) -> FractureParameters {
+    FractureParameters {
+        criterion,
+        ..FractureParameters::default()
+    }
+}
+
+fn orient(a: &Vec2, b: &Vec2, x: &Vec2) -> Real {
+    let d = b - a;
+    (d.x * (x.y - a.y) - d.y * (x.x - a.x)) / d.norm()
+}
+
+/// Whether segment `[x, p]` crosses segment `[a, b]` at interior points of
+/// both, with both ends clearly (beyond round-off) on opposite sides.
+fn strictly_crosses(a: &Vec2, b: &Vec2, x: &Vec2, p: &Vec2) -> bool {
+    let tol = 1e-9 * H;
+    let (o1, o2) = (orient(a, b, x), orient(a, b, p));
+    let (o3, o4) = (orient(x, p, a), orient(x, p, b));
+    o1.abs() > tol
+        && o2.abs() > tol
+        && o1 * o2 < 0.0
+        && o3.abs() > tol
+        && o4.abs() > tol
+        && o3 * o4 < 0.0
+}
+
+struct Invariants {
+    mass: Real,
+    momentum: Vec2,
+}
+
+fn snapshot(m: &Model) -> Invariants {
+    Invariants {
+        mass: m.particles.total_mass(),
+        momentum: m.particles.momentum(),
+    }
+}
+
+/// Mass and momentum unchanged, reproduction at every quadrature point,
+/// and no (evaluation point, particle) pair of either table across a crack.
+fn check_invariants(m: &Model, growth: &CrackGrowth, before: &Invariants, what: &str) {
+    let p = &m.particles;
+    let mass = p.total_mass();
+    assert!(
+        (mass - before.mass).abs() <= 1e-12 * before.mass,
+        "{what}: mass {mass} vs {}",
+        before.mass
+    );
+    let vmax = p.v.iter().map(|v| v.norm()).fold(0.0, Real::max).max(1.0);
+    let dp = (p.momentum() - before.momentum).norm();
+    assert!(
+        dp <= 1e-12 * before.mass * vmax,
+        "{what}: momentum changed by {dp:e}"
+    );
+    eprintln!(
+        "{what}: relative mass error {:.2e}, momentum error {:.2e} (of M v_max)",
+        (mass - before.mass).abs() / before.mass,
+        dp / (before.mass * vmax)
+    );
+    let t = &m.qp_shape;
+    for q in 0..t.rows() {
+        let (mut s, mut sx, mut g, mut gx) = (
+            0.0,
+            Vec2::zeros(),
+            Vec2::zeros(),
+            nalgebra::Matrix2::<Real>::zeros(),
+        );
+        for k in t.range(q) {
+            let i = t.index[k] as usize;
+            s += t.value[k];
+            sx += p.x0[i] * t.value[k];
+            g += t.grad[k];
+            gx += p.x0[i] * t.grad[k].transpose();
+        }
+        let x = m.quad.x0[q];
+        assert!(
+            (s - 1.0).abs() < 1e-9,
+            "{what}: partition of unity at qp {q}: {s}"
+        );
+        assert!(g.norm() < 1e-6 / H, "{what}: gradient sum at qp {q}: {g:?}");
+        if growth.reduced_quadrature_rows.get(&q) == Some(&Basis::Constant) {
+            continue; // no full neighbourhood: partition of unity only
+        }
+        assert!(
+            (sx - x).norm() < 1e-9 * H,
+            "{what}: linear reproduction at qp {q}"
+        );
+        assert!(
+            (gx - nalgebra::Matrix2::identity()).norm() < 1e-7,
+            "{what}: gradient reproduction at qp {q}"
+        );
+    }
+    let segs: Vec<(Vec2, Vec2)> = growth
+        .cracks
+        .iter()
+        .flat_map(|c| {
+            c.vertices
+                .windows(2)
+                .map(|w| (w[0].x0, w[1].x0))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let crossing = |table: &ShapeTable, points: &[Vec2], label: &str| {
+        for r in 0..table.rows() {
+            for k in table.range(r) {
+                let i = table.index[k] as usize;
+                for (a, b) in &segs {
+                    assert!(
+                        !strictly_crosses(a, b, &points[r], &p.x0[i]),
+                        "{what}: {label} row {r} uses particle {i} across crack segment {a:?}-{b:?}"
+                    );
+                }
+            }
+        }
+    };
+    crossing(&m.qp_shape, &m.quad.x0, "quadrature");
+    crossing(&m.particle_shape, &p.x0, "particle");
+    assert_eq!(m.particle_shape.rows(), p.len());
+    assert_eq!(m.gather.offsets.len(), p.len() + 1);
+}
+
+/// Drive growth with a prescribed criterion field; check the invariants
+/// after every stage that changed something. Returns the growth state.
+fn drive(m: &mut Model, g: &mut CrackGrowth, calls: usize) {
+    for step in 1..=calls as u64 {
+        let before = snapshot(m);
+        let n_events = g.events.len();
+        g.grow(m, step as Real * 1e-8, step).unwrap();
+        if g.events.len() > n_events {
+            check_invariants(m, g, &before, &format!("step {step}"));
+        }
+    }
+}
+
+fn set_field(m: &mut Model, f: impl Fn(&Vec2) -> Real) {
+    for q in 0..m.quad.len() {
+        m.quad.eps_p[q] = f(&m.quad.x0[q]);
+    }
+}
+
+fn non_uniform_velocity(m: &mut Model) {
+    for i in 0..m.particles.len() {
+        let x = m.particles.x0[i];
+        m.particles.v[i] = Vec2::new(10.0 + 3.0e4 * x.y - 1.0e4 * x.x, -5.0 + 2.0e4 * x.x);
+    }
+}
+
+#[test]
+fn splits_conserve_mass_and_momentum_and_reproduction() {
+    let (nx, ny) = (25, 9);
+    let mut m = plate(nx, ny);
+    non_uniform_velocity(&mut m);
+    let top = (ny - 1) as Real * H;
+    let xc = 10.0 * H;
+    // an oblique band (slope 0.4) through the thickness
+    set_field(&mut m, |x| {
+        0.6 * (-((x.x - xc - 0.4 * (top - x.y)) / H).powi(2)).exp()
+    });
+    let mut g = CrackGrowth::new(params(Criterion::EffectiveStrain));
+    drive(&mut m, &mut g, 30);
+    assert_eq!(
+        g.cracks.len(),
+        1,
+        "one crack (the other surface is within the exclusion distance)"
+    );
+    let c = &g.cracks[0];
+    assert!(
+        c.arrested.is_some(),
+        "the crack runs through and arrests: {:?}",
+        g.events
+    );
+    let first = c.vertices[0].x0;
+    let last_split = c.vertices[c.vertices.len() - 2].x0;
+    assert!(
+        (first.y - last_split.y).abs() > (ny - 1) as Real * H - 1e-12,
+        "through the thickness"
+    );
+    assert!(
+        g.events
+            .iter()
+            .filter(|e| e.kind == EventKind::Propagate)
+            .count()
+            >= 3
+    );
+    // every split particle and its sibling carry the crack-face flag and are slaves
+    for e in &g.events {
+        for &i in &e.particles[..2] {
+            let f = m.particles.flags[i];
+            assert!(f.has(ParticleFlags::CRACK_FACE) && f.has(ParticleFlags::SLAVE));
+        }
+    }
+}
+
+#[test]
+fn arrest_at_the_far_surface_without_running_along_it() {
+    let (nx, ny) = (25, 9);
+    let mut m = plate(nx, ny);
+    let top = (ny - 1) as Real * H;
+    let xc = 4.0 * H;
+    // a 45-degree band to the bottom surface, and the whole bottom strip failed
+    set_field(&mut m, |x| {
+        let band = (-((x.x - xc - (top - x.y)) / (0.7 * H)).powi(2)).exp();
+        let strip = if x.y < 1.2 * H { 1.0 } else { 0.0 };
+        0.6 * band.max(strip)
+    });
+    let mut g = CrackGrowth::new(FractureParameters {
+        nucleation_distance_factor: 100.0,
+        ..params(Criterion::EffectiveStrain)
+    });
+    // start at the top where the band begins, pointing down the band
+    let (i0, j0) = (4, ny - 1);
+    g.insert_crack(&mut m, &[j0 * nx + i0, (j0 - 1) * nx + i0 + 1], false)
+        .unwrap();
+    drive(&mut m, &mut g, 40);
+    let c = &g.cracks[0];
+    assert!(c.arrested.is_some(), "arrested: {:?}", g.events);
+    let n = c.vertices.len();
+    let at_surface = c.vertices[n - 2].x0;
+    assert!(
+        at_surface.y.abs() < 1e-12,
+        "stopped on the far surface: {at_surface:?}"
+    );
+    // no vertex before the arrival runs along the bottom
+    assert!(
+        c.vertices[..n - 2].iter().all(|v| v.x0.y > 0.5 * H),
+        "ran along the surface: {:?}",
+        c.vertices
+    );
+    // the end point is just outside the surface, below the arrival point
+    assert!(c.vertices[n - 1].x0.y < 0.0 && c.vertices[n - 1].x0.y > -0.05 * H);
+    // and nothing happens to it afterwards
+    let events = g.events.len();
+    drive(&mut m, &mut g, 5);
+    assert!(g.events[events..].iter().all(|e| e.crack != 0));
+}
+
+#[test]
+fn shape_function_ahead_of_the_tip_is_cut_in_two() {
+    let (nx, ny) = (21, 11);
+    let xc = 10;
+    let path: Vec<usize> = (3..ny).rev().map(|j| j * nx + xc).collect(); // top down the middle column
+    let support_of = |m: &Model, i: usize| -> Vec<usize> {
+        (0..m.quad.len())
+            .filter(|&q| {
+                m.qp_shape
+                    .range(q)
+                    .any(|k| m.qp_shape.index[k] as usize == i)
+            })
+            .collect()
+    };
+    let x_mid = xc as Real * H;
+    // crack down to row 6; particle k = (xc, 5) is just ahead of the tip
+    let mut a = plate(nx, ny);
+    let mut ga = CrackGrowth::new(params(Criterion::None));
+    ga.insert_crack(&mut a, &path[..5], false).unwrap();
+    let k = 5 * nx + xc;
+    assert_eq!(ga.cracks[0].tip, Some(6 * nx + xc));
+    let before = support_of(&a, k);
+    assert!(
+        before.iter().any(|&q| a.quad.x0[q].x < x_mid)
+            && before.iter().any(|&q| a.quad.x0[q].x > x_mid)
+    );
+    // the crack passes k (two more particles)
+    let mut b = plate(nx, ny);
+    let mut gb = CrackGrowth::new(params(Criterion::None));
+    let inv = snapshot(&b);
+    gb.insert_crack(&mut b, &path[..7], false).unwrap();
+    check_invariants(&b, &gb, &inv, "crack past k");
+    let ev = gb
+        .events
+        .iter()
+        .find(|e| e.particles[0] == k)
+        .expect("k was split");
+    let (kl, kr) = (ev.particles[0], ev.particles[1]);
+    let (sl, sr) = (support_of(&b, kl), support_of(&b, kr));
+    assert!(!sl.is_empty() && !sr.is_empty());
+    // growing downward, the left of the path is +x
+    assert!(
+        sl.iter().all(|&q| b.quad.x0[q].x > x_mid),
+        "left child lives on the left"
+    );
+    assert!(
+        sr.iter().all(|&q| b.quad.x0[q].x < x_mid),
+        "right child lives on the right"
+    );
+    let covered = before
+        .iter()
+        .filter(|q| sl.contains(q) || sr.contains(q))
+        .count();
+    assert!(
+        covered as Real >= 0.95 * before.len() as Real,
+        "{covered} of {}",
+        before.len()
+    );
+    // the halves carry the parent's volume
+    assert!(
+        (b.particles.volume[kl] + b.particles.volume[kr] - a.particles.volume[k]).abs() < 1e-15
+    );
+}
+
+/// An edge crack halfway across a plate pulled apart: the normal stress at
+/// the quadrature points next to the faces drops to a small fraction of
+/// that in the uncracked plate, which carries the load there.
+#[test]
+fn crack_faces_are_traction_free_under_tension() {
+    let (nx, ny) = (21, 21);
+    let v0 = 2.0;
+    let run = |cracked: bool| -> (Model, Vec<usize>) {
+        let mut m = plate(nx, ny);
+        if cracked {
+            let mut g = CrackGrowth::new(params(Criterion::None));
+            let path: Vec<usize> = (0..=10).map(|i| 10 * nx + i).collect();
+            g.insert_crack(&mut m, &path, false).unwrap();
+        }
+        for i in 0..m.particles.len() {
+            let y = m.particles.x0[i].y;
+            if y < 1.5 * H || y > (ny as Real - 2.5) * H {
+                m.particles.flags[i].set(ParticleFlags::FIX_Y);
+                m.particles.v[i].y = if y < 1.5 * H { -v0 } else { v0 };
+            }
+        }
+        let mut sim = Simulation::new(m, TimeStepRule::Cfl { safety: 0.5 });
+        while sim.time < 8e-6 {
+            sim.step().unwrap();
+        }
+        let mid = 10.0 * H;
+        let near: Vec<usize> = (0..sim.model.quad.len())
+            .filter(|&q| {
+                let x = sim.model.quad.x0[q];
+                (x.y - mid).abs() < 0.5 * H && x.x < 8.0 * H
+            })
+            .collect();
+        (sim.model, near)
+    };
+    let sigma_yy = |m: &Model, q: usize| m.quad.tau[q][(1, 1)] / m.quad.f[q].determinant();
+    let (intact, near) = run(false);
+    let (cracked, near_c) = run(true);
+    assert_eq!(near, near_c);
+    let mean =
+        |m: &Model| near.iter().map(|&q| sigma_yy(m, q).abs()).sum::<Real>() / near.len() as Real;
+    let (s_intact, s_cracked) = (mean(&intact), mean(&cracked));
+    eprintln!(
+        "mean |sigma_yy| next to the faces: intact {s_intact:.3e} Pa, cracked {s_cracked:.3e} Pa"
+    );
+    assert!(
+        s_intact > 50e6,
+        "the intact plate carries the load: {s_intact:e} Pa"
+    );
+    assert!(
+        s_cracked < 0.15 * s_intact,
+        "faces traction-free: {s_cracked:e} vs {s_intact:e} Pa"
+    );
+}
+
+const SMALL_IMPACT: &str = r#"
+title = "small plate, blunt projectile"
+[geometry]
+mode = "plane_strain"
+[[bodies]]
+name = "plate"
+material = "weldox_460e"
+[bodies.rectangle]
+x_min = -0.012
+x_max = 0.012
+y_min = 0.0
+y_max = 0.004
+layers = 9
+[[bodies.supports]]
+region = { x_min = -0.012, x_max = -0.011, y_min = 0.0, y_max = 0.004 }
+[[bodies.supports]]
+region = { x_min = 0.011, x_max = 0.012, y_min = 0.0, y_max = 0.004 }
+[[rigid_bodies]]
+name = "projectile"
+rectangle = { center = [0.0, 0.01405], width = 0.008, height = 0.02 }
+density = 7850.0
+velocity = [0.0, -400.0]
+[fracture]
+criterion = "effective_strain"
+[time]
+end = 12.0e-6
+"#;
+
+fn small_impact(end: Real) -> Simulation {
+    let case = Case::from_str_with(SMALL_IMPACT, "small", &[format!("time.end={end}")]).unwrap();
+    let mut sim = plugsim::run::build_simulation(&case.resolved()).unwrap();
+    while sim.time < end {
+        sim.step().unwrap();
+    }
+    sim
+}
+
+/// Cracks nucleate at the projectile's corners (x = ±4 mm on the impact
+/// face) by themselves and run into the plate.
+#[test]
+fn end_to_end_cracks_start_at_the_projectile_corners() {
+    let sim = small_impact(12e-6);
+    let g = sim.cracks.as_ref().unwrap();
+    assert!(g.cracks.len() >= 2, "two cracks: {:?}", g.events);
+    let mut sides = [false, false];
+    for c in &g.cracks {
+        let p0 = c.vertices[0].x0;
+        assert!(
+            (p0.y - 0.004).abs() < 1e-9,
+            "nucleated on the impact face: {p0:?}"
+        );
+        assert!((p0.x.abs() - 0.004).abs() < 1.5e-3, "at a corner: {p0:?}");
+        sides[(p0.x > 0.0) as usize] = true;
+        assert!(c.vertices.len() >= 3, "propagated: {:?}", c.vertices);
+    }
+    assert!(sides[0] && sides[1]);
+    let slaves = sim.contact.as_ref().unwrap().slaves.particles().to_vec();
+    for e in &g.events {
+        for &i in &e.particles[..2] {
+            assert!(
+                slaves.binary_search(&(i as u32)).is_ok(),
+                "crack face {i} is a contact slave"
+            );
+        }
+    }
+}
+
+/// The same case gives the same crack path, bit for bit, on 1 and 2 threads.
+#[test]
+fn crack_paths_do_not_depend_on_the_thread_count() {
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let sim = small_impact(8e-6);
+            let g = sim.cracks.unwrap();
+            (g.events, g.cracks, sim.model.particles.x0)
+        })
+    };
+    let one = run(1);
+    let two = run(2);
+    assert!(!one.0.is_empty(), "cracks formed");
+    assert_eq!(one.0, two.0);
+    assert_eq!(one.1, two.1);
+    assert_eq!(one.2, two.2);
+}
+
+/// The shipped fracture case parses, validates and asks for the
+/// effective-strain criterion at [RL10]'s critical value.
+#[test]
+fn borvik_plane_strain_case_file_is_valid() {
+    let text = include_str!("../cases/borvik-1-plane-strain.toml");
+    let case = Case::from_str_with(text, "borvik-1-plane-strain.toml", &[]).unwrap();
+    assert_eq!(case.fracture.criterion, Criterion::EffectiveStrain);
+    assert_eq!(case.fracture.critical_effective_strain, 0.30);
+    assert!(case.time.end >= 60e-6);
+    // no [fracture] section: no cracks
+    let plain = include_str!("../cases/borvik-1-nofracture.toml");
+    let case = Case::from_str_with(plain, "nofracture", &[]).unwrap();
+    assert_eq!(case.fracture.criterion, Criterion::None);
+}
+
+/// Bad `[fracture]` values are all reported, each with its key.
+#[test]
+fn fracture_section_is_validated() {
+    let text = include_str!("../cases/borvik-1-plane-strain.toml");
+    let sets = [
+        "fracture.critical_effective_strain=-0.1".to_string(),
+        "fracture.fan_angle=200.0".to_string(),
+        "fracture.offset_ratio=0.5".to_string(),
+        "fracture.radius_factor=0.5".to_string(),
+    ];
+    let err = Case::from_str_with(text, "f.toml", &sets)
+        .unwrap_err()
+        .to_string();
+    for key in [
+        "critical_effective_strain",
+        "fan_angle",
+        "offset_ratio",
+        "radius_factor",
+    ] {
+        assert!(
+            err.contains(&format!("fracture.{key}")),
+            "{key} not reported: {err}"
+        );
+    }
+    let unknown = Case::from_str_with(text, "f.toml", &["fracture.theta=1.0".to_string()])
+        .unwrap_err()
+        .to_string();
+    assert!(unknown.contains("theta"), "{unknown}");
+    let bad = Case::from_str_with(
+        text,
+        "f.toml",
+        &["fracture.criterion=\"stress\"".to_string()],
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(bad.contains("stress"), "{bad}");
+}
