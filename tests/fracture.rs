@@ -29,8 +29,9 @@ fn steel() -> Elastic {
     }
 }
 
-/// A uniform `nx × ny` lattice of spacing `H` on `[0, (nx−1)H] × [0, (ny−1)H]`;
-/// particle `(i, j)` is `j nx + i`. Surface particles are contact slaves.
+/// A uniform `nx × ny` lattice of spacing `H` on `[0, (nx−1)H] × [0, (ny−1)H]`
+/// (stored along a Morton curve: find lattice particle `(i, j)` with [`id`]).
+/// Surface particles are contact slaves.
 fn plate(nx: usize, ny: usize) -> Model {
     let grid = RectangleGrid {
         x_min: 0.0,
@@ -63,6 +64,14 @@ fn plate(nx: usize, ny: usize) -> Model {
     .unwrap();
     slaves.mark_flags(&mut m.particles.flags).unwrap();
     m
+}
+
+/// Index of the lattice particle at `(i H, j H)`.
+fn id(m: &Model, i: usize, j: usize) -> usize {
+    let x = Vec2::new(i as Real * H, j as Real * H);
+    (0..m.particles.len())
+        .find(|&k| (m.particles.x0[k] - x).norm() < 1e-9 * H)
+        .unwrap_or_else(|| panic!("no particle at lattice ({i}, {j})"))
 }
 
 fn params(criterion: Criterion) -> FractureParameters {
@@ -276,7 +285,8 @@ fn arrest_at_the_far_surface_without_running_along_it() {
     });
     // start at the top where the band begins, pointing down the band
     let (i0, j0) = (4, ny - 1);
-    g.insert_crack(&mut m, &[j0 * nx + i0, (j0 - 1) * nx + i0 + 1], false)
+    let start = [id(&m, i0, j0), id(&m, i0 + 1, j0 - 1)];
+    g.insert_crack(&mut m, &start, false)
         .unwrap();
     drive(&mut m, &mut g, 40);
     let c = &g.cracks[0];
@@ -305,7 +315,8 @@ fn arrest_at_the_far_surface_without_running_along_it() {
 fn shape_function_ahead_of_the_tip_is_cut_in_two() {
     let (nx, ny) = (21, 11);
     let xc = 10;
-    let path: Vec<usize> = (3..ny).rev().map(|j| j * nx + xc).collect(); // top down the middle column
+    // top down the middle column
+    let path_of = |m: &Model| -> Vec<usize> { (3..ny).rev().map(|j| id(m, xc, j)).collect() };
     let support_of = |m: &Model, i: usize| -> Vec<usize> {
         (0..m.quad.len())
             .filter(|&q| {
@@ -319,9 +330,10 @@ fn shape_function_ahead_of_the_tip_is_cut_in_two() {
     // crack down to row 6; particle k = (xc, 5) is just ahead of the tip
     let mut a = plate(nx, ny);
     let mut ga = CrackGrowth::new(params(Criterion::None));
+    let path = path_of(&a);
+    let (k, k_tip) = (id(&a, xc, 5), id(&a, xc, 6));
     ga.insert_crack(&mut a, &path[..5], false).unwrap();
-    let k = 5 * nx + xc;
-    assert_eq!(ga.cracks[0].tip, Some(6 * nx + xc));
+    assert_eq!(ga.cracks[0].tip, Some(k_tip));
     let before = support_of(&a, k);
     assert!(
         before.iter().any(|&q| a.quad.x0[q].x < x_mid)
@@ -376,7 +388,7 @@ fn crack_faces_are_traction_free_under_tension() {
         let mut m = plate(nx, ny);
         if cracked {
             let mut g = CrackGrowth::new(params(Criterion::None));
-            let path: Vec<usize> = (0..=10).map(|i| 10 * nx + i).collect();
+            let path: Vec<usize> = (0..=10).map(|i| id(&m, i, 10)).collect();
             g.insert_crack(&mut m, &path, false).unwrap();
         }
         for i in 0..m.particles.len() {
