@@ -18,5 +18,7 @@ pub mod step;
 pub mod case;
 pub mod output;
 pub mod run;
+pub mod checkpoint;
+pub mod memory;
 pub mod cases;
 pub mod material_point;
