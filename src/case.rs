@@ -216,7 +216,7 @@ pub struct CheckpointSpec {
     pub interval: Option<Real>,
     /// Wall-clock time between checkpoints, s; 0 turns them off. Default
     /// 1800 s: a crash costs at most half an hour of computing, and a
-    /// checkpoint of even [RL10]'s fine model (about 0.25 GB) takes seconds,
+    /// checkpoint of even \[RL10\]'s fine model (about 0.25 GB) takes seconds,
     /// a negligible share of the run.
     #[serde(default = "half_hour")]
     pub wall_interval: Real,

@@ -342,7 +342,7 @@ fn time_loop(
                 schedule.next_snapshot += interval;
                 output_wall += t.elapsed();
             }
-            if sim.step % case.output.history_every == 0 || done {
+            if sim.step.is_multiple_of(case.output.history_every) || done {
                 let t = Instant::now();
                 out.history_row(&sim)?;
                 schedule.max_drift = schedule.max_drift.max(sim.energies.drift().abs());
@@ -378,7 +378,7 @@ fn time_loop(
             out.history_row(&sim)?;
             return Err(RunError::Unstable { error, last_snapshot: last, dir: cfg.out_dir.clone() });
         }
-        if sim.step % report_every == 0 {
+        if sim.step.is_multiple_of(report_every) {
             progress(Progress::Step { sim: &sim });
         }
     }

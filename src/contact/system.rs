@@ -408,7 +408,11 @@ impl ContactSystem {
         ];
         for (field, found) in lens {
             if found != nb {
-                return Err(ContactError::LengthMismatch { field, expected: nb, found });
+                return Err(ContactError::LengthMismatch {
+                    field,
+                    expected: nb,
+                    found,
+                });
             }
         }
         self.work_on_particles = a.work_on_particles;
