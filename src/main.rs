@@ -248,7 +248,7 @@ fn check(case: &Case, file: &str) -> Result<()> {
     println!("  time step       {:.3e} s ({} steps to {:.3e} s)", sim.dt, (resolved.time.end / sim.dt).ceil(), resolved.time.end);
     let cfl = sim.model.min_spacing() / sim.model.max_wave_speed();
     if sim.dt > cfl {
-        println!("  WARNING: the time step is {:.1} times the CFL limit {cfl:.3e} s; the run will likely go unstable", sim.dt / cfl);
+        println!("  WARNING: the time step is {:.1} times the CFL limit {cfl:.3e} s; the run may go unstable", sim.dt / cfl);
     }
     let (available, origin) = plugsim::memory::available_memory();
     println!(

@@ -30,9 +30,9 @@ pub const BYTES_PER_QUADRATURE_ENTRY: Real = 36.0;
 pub const BYTES_PER_PARTICLE_ENTRY: Real = 28.0;
 /// Factor for what the builders hold while the tables are assembled
 /// (neighbour lists, per-body tables before concatenation). Measured peak
-/// resident memory of `plugsim check` on the shipped cases is below the
-/// estimate with this factor (`estimate_bounds_the_measured_peak` documents
-/// the measurement).
+/// resident memory of `plugsim check` (`/usr/bin/time -f %M`): 80 MB for
+/// `borvik-1-nofracture` (estimate 113 MiB), 281 MB for it with 48 layers
+/// (estimate 502 MiB); the estimate errs high, as a guard should.
 pub const BUILD_OVERHEAD: Real = 1.5;
 /// Memory assumed available where `/proc/meminfo` cannot be read (other
 /// operating systems, restricted containers): 16 GiB, a typical workstation.
@@ -65,11 +65,13 @@ impl Footprint {
                 + self.particle_entries * BYTES_PER_PARTICLE_ENTRY)
     }
 
-    /// Size of a checkpoint of this model, bytes (all stores and tables;
-    /// see `checkpoint`).
+    /// Size of a checkpoint of this model, bytes: per particle its 13
+    /// columns (141 B), the contact force and two row offsets (32 B); per
+    /// quadrature point its 10 columns (276 B) and a row offset (8 B); per
+    /// table entry as in memory (see `checkpoint`).
     pub fn checkpoint_bytes(&self) -> Real {
-        self.particles * 220.0
-            + self.quadrature_points * 310.0
+        self.particles * 173.0
+            + self.quadrature_points * 284.0
             + self.quadrature_entries * 36.0
             + self.particle_entries * 28.0
     }
