@@ -20,6 +20,8 @@ pub mod thermal;
 pub mod case;
 pub mod output;
 pub mod run;
+pub mod checkpoint;
+pub mod memory;
 pub mod cases;
 pub mod material_point;
 pub mod bench;

@@ -5,9 +5,11 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use plugsim::case::Case;
 use plugsim::cases::{builtin_case, BUILTIN_CASES};
-use plugsim::run::{execute, Progress, RunConfig, RunInfo};
+use plugsim::run::{execute, resume, Progress, RunConfig, RunError, RunInfo, RunSummary};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
 #[derive(Parser)]
@@ -39,6 +41,11 @@ enum Command {
         /// Write into an existing non-empty output directory.
         #[arg(long)]
         force: bool,
+    },
+    /// Continue an interrupted run in its output directory from its newest checkpoint.
+    Resume {
+        /// The run's output directory (holding `checkpoints/`).
+        dir: PathBuf,
     },
     /// Check a case file without running it: validation, particle counts, time step.
     Check {
@@ -133,7 +140,12 @@ fn main() {
         Ok(()) => 0,
         Err(e) => {
             eprintln!("error: {e:#}");
-            1
+            // 130 = 128 + SIGINT, the shell's code for a run stopped by Ctrl-C.
+            if matches!(e.downcast_ref::<RunError>(), Some(RunError::Interrupted { .. })) {
+                130
+            } else {
+                1
+            }
         }
     };
     std::process::exit(code);
@@ -160,7 +172,39 @@ fn dispatch(cmd: Command) -> Result<()> {
             let out_dir = out
                 .or_else(|| case.output.directory.as_ref().map(PathBuf::from))
                 .unwrap_or_else(|| Path::new("runs").join(&name));
-            run(&case, &file, &set, out_dir, force)
+            let cfg = RunConfig { out_dir, force, info: RunInfo::current(&file, &set), interrupt: install_interrupt_handler() };
+            drive(&cfg, |cfg, report| execute(&case, cfg, report))
+        }
+        Command::Resume { dir } => {
+            let cfg = RunConfig {
+                out_dir: dir.clone(),
+                force: false,
+                info: RunInfo::current(&dir.display().to_string(), &[]),
+                interrupt: install_interrupt_handler(),
+            };
+            drive(&cfg, |cfg, report| resume(cfg, report))
+        }
+    }
+}
+
+/// Catch Ctrl-C and SIGTERM: the first sets the returned flag (the run
+/// finishes its step, writes a checkpoint and stops), the second stops at
+/// once (the checkpoints written so far are intact).
+fn install_interrupt_handler() -> Option<Arc<AtomicBool>> {
+    let flag = Arc::new(AtomicBool::new(false));
+    let seen = flag.clone();
+    let handler = move || {
+        if seen.swap(true, Ordering::SeqCst) {
+            eprintln!("\nplugsim: second interrupt: stopping now, without a new checkpoint");
+            std::process::exit(130);
+        }
+        eprintln!("\nplugsim: interrupted: finishing this step and writing a checkpoint (interrupt again to stop at once)");
+    };
+    match ctrlc::set_handler(handler) {
+        Ok(()) => Some(flag),
+        Err(e) => {
+            eprintln!("warning: cannot catch Ctrl-C / SIGTERM ({e}); an interrupted run will not write a checkpoint");
+            None
         }
     }
 }
@@ -236,7 +280,7 @@ fn bench(name: &str, steps: usize, whole: Option<f64>, set: &[String]) -> Result
             let mut c = case.clone();
             c.time.end = end;
             c.output.interval = Some(1e-6);
-            let cfg = RunConfig { out_dir: dir.clone(), force: true, info: RunInfo::current(name, set) };
+            let cfg = RunConfig::new(dir.clone(), true, RunInfo::current(name, set));
             let t = Instant::now();
             let s = bench::with_threads(threads, || execute(&c, &cfg, &mut |_| {}))?;
             let wall = t.elapsed().as_secs_f64();
@@ -260,6 +304,7 @@ fn bench(name: &str, steps: usize, whole: Option<f64>, set: &[String]) -> Result
 fn check(case: &Case, file: &str) -> Result<()> {
     let resolved = case.resolved();
     let t = Instant::now();
+    let footprint = plugsim::run::preflight(&resolved)?;
     let sim = plugsim::run::build_simulation(&resolved).context("building the discretization")?;
     println!("{file}: OK ({})", if case.title.is_empty() { "untitled" } else { &case.title });
     println!("  geometry        {:?}", resolved.geometry.mode);
@@ -280,20 +325,49 @@ fn check(case: &Case, file: &str) -> Result<()> {
         println!("  contact slaves  {} surface particles", c.slaves.len());
     }
     println!("  time step       {:.3e} s ({} steps to {:.3e} s)", sim.dt, (resolved.time.end / sim.dt).ceil(), resolved.time.end);
+    let cfl = sim.model.min_spacing() / sim.model.max_wave_speed();
+    if sim.dt > cfl {
+        println!("  WARNING: the time step is {:.1} times the CFL limit {cfl:.3e} s; the run may go unstable", sim.dt / cfl);
+    }
+    let (available, origin) = plugsim::memory::available_memory();
+    println!(
+        "  memory          about {} ({} available: {origin}); a checkpoint about {}",
+        plugsim::memory::human_bytes(footprint.bytes()),
+        plugsim::memory::human_bytes(available as f64),
+        plugsim::memory::human_bytes(footprint.checkpoint_bytes())
+    );
     println!("  mass            {:.6e} kg", sim.model.particles.total_mass());
     println!("  built in        {:.2} s", t.elapsed().as_secs_f64());
     Ok(())
 }
 
-fn run(case: &Case, file: &str, set: &[String], out_dir: PathBuf, force: bool) -> Result<()> {
-    let cfg = RunConfig { out_dir: out_dir.clone(), force, info: RunInfo::current(file, set) };
+/// Run `job` (a fresh run or a resume) with a progress bar or progress lines,
+/// then print the summary.
+fn drive(cfg: &RunConfig, job: impl FnOnce(&RunConfig, &mut dyn FnMut(Progress)) -> Result<RunSummary, RunError>) -> Result<()> {
+    let out_dir = cfg.out_dir.clone();
     let tty = std::io::stderr().is_terminal();
     let bar = ProgressBar::hidden();
     let started = Instant::now();
-    let end = case.time.end;
+    let (mut end, mut first_step) = (0.0, 0u64);
     let mut last_line = 0u64;
     let mut report = |p: Progress| match p {
-        Progress::Started { sim, steps_estimate } => {
+        Progress::Resumed { sim, checkpoint, warnings } => {
+            for w in warnings {
+                eprintln!("warning: {w}");
+            }
+            eprintln!("plugsim: resuming from {} at step {} (t = {:.4e} s)", checkpoint.display(), sim.step, sim.time);
+        }
+        Progress::Checkpoint { sim, path } => {
+            let line = format!("  checkpoint at step {} (t = {:.4e} s): {}", sim.step, sim.time, path.display());
+            if tty {
+                bar.println(line);
+            } else {
+                eprintln!("{line}");
+            }
+        }
+        Progress::Finished { .. } => {}
+        Progress::Started { sim, steps_estimate, end: run_end } => {
+            (end, first_step) = (run_end, sim.step);
             eprintln!(
                 "plugsim: {} particles, {} quadrature points, dt = {:.3e} s, {} steps, {} threads -> {}",
                 sim.model.particles.len(),
@@ -322,13 +396,13 @@ fn run(case: &Case, file: &str, set: &[String], out_dir: PathBuf, force: bool) -
                 let pct = (100.0 * sim.time / end) as u64;
                 if pct >= last_line + 10 {
                     last_line = pct - pct % 10;
-                    let rate = sim.step as f64 / started.elapsed().as_secs_f64();
+                    let rate = (sim.step - first_step) as f64 / started.elapsed().as_secs_f64();
                     eprintln!("  {pct:3}%  {msg}  ({rate:.0} steps/s)");
                 }
             }
         }
     };
-    let result = execute(case, &cfg, &mut report);
+    let result = job(cfg, &mut report);
     bar.finish_and_clear();
     let s = result?;
     let total = s.setup_wall + s.loop_wall + s.output_wall;

@@ -79,6 +79,63 @@ impl OutputWriter {
         })
     }
 
+    /// Continue the outputs of a resumed run in `dir`: the series holds the
+    /// snapshots at `snapshot_times` (`particles_00000.vtu`, ...), snapshot
+    /// files after them are removed, and `history.csv` is cut to its first
+    /// `history_bytes` bytes (the rows up to the checkpoint) and continued.
+    pub fn resume(
+        dir: &Path,
+        fields: &[String],
+        rigid_names: &[String],
+        snapshot_times: &[Real],
+        history_bytes: u64,
+    ) -> Result<Self, IoError> {
+        let cols = history_columns(rigid_names);
+        let cols: Vec<&str> = cols.iter().map(|s| s.as_str()).collect();
+        let history = HistoryWriter::continue_at(&dir.join("history.csv"), &cols, history_bytes)?;
+        let entries = snapshot_times
+            .iter()
+            .enumerate()
+            .map(|(k, &time)| crate::io::PvdEntry { time, file: snapshot_name(k), part: 0 })
+            .collect();
+        let series = PvdSeries::with_entries(&dir.join("results.pvd"), entries)?;
+        let n = snapshot_times.len();
+        if let Ok(listing) = std::fs::read_dir(dir) {
+            for e in listing.flatten() {
+                let name = e.file_name().to_string_lossy().to_string();
+                let index = name.strip_prefix("particles_").and_then(|r| r.strip_suffix(".vtu")).and_then(|k| k.parse::<usize>().ok());
+                if index.is_some_and(|k| k >= n) {
+                    std::fs::remove_file(e.path()).map_err(|source| IoError::Write { path: e.path(), source })?;
+                }
+            }
+        }
+        Ok(OutputWriter {
+            dir: dir.to_path_buf(),
+            fields: fields.to_vec(),
+            series,
+            history,
+            snapshots: n,
+            crack_log: None,
+            crack_events_written: 0,
+        })
+    }
+
+    /// Simulated times of the snapshots written so far, s.
+    pub fn snapshot_times(&self) -> Vec<Real> {
+        self.series.entries().iter().filter(|e| e.part == 0).map(|e| e.time).collect()
+    }
+
+    /// Length of `history.csv` so far, bytes.
+    pub fn history_bytes(&self) -> u64 {
+        self.history.bytes()
+    }
+
+    /// `fsync` the history, so that a checkpoint never counts rows that a
+    /// power loss could take back.
+    pub fn sync(&self) -> Result<(), IoError> {
+        self.history.sync()
+    }
+
     /// The output directory.
     pub fn dir(&self) -> &Path {
         &self.dir
@@ -86,7 +143,7 @@ impl OutputWriter {
 
     /// Write `particles_NNNNN.vtu` for the current state and add it to the series.
     pub fn snapshot(&mut self, sim: &Simulation) -> Result<PathBuf, IoError> {
-        let name = format!("particles_{:05}.vtu", self.snapshots);
+        let name = snapshot_name(self.snapshots);
         let path = self.dir.join(&name);
         write_vtu(&path, &particle_piece(&sim.model, &self.fields))?;
         self.series.append(sim.time, &name, 0)?;
@@ -181,6 +238,11 @@ pub fn crack_piece(model: &Model, cracks: &crate::fracture::CrackGrowth) -> VtuP
     VtuPiece::poly_lines(points, lines)
         .with_cell_data(DataArray::integers("crack", ids))
         .with_cell_data(DataArray::integers("face", faces))
+}
+
+/// File name of snapshot `k`.
+pub fn snapshot_name(k: usize) -> String {
+    format!("particles_{k:05}.vtu")
 }
 
 fn v3(v: &Vec2) -> [f64; 3] {

@@ -2,14 +2,18 @@
 //! history, summary. The library never prints: progress goes to a callback.
 
 use crate::case::Case;
+use crate::checkpoint::{CheckpointError, RunProgress};
 use crate::io::IoError;
 use crate::math::Real;
 use crate::contact::{ContactSystem, SlaveSet, SurfaceDetection};
+use crate::memory::{Footprint, MemoryError};
 use crate::model::{Model, ModelError};
 use crate::output::OutputWriter;
 use crate::step::{Simulation, SolverError};
 use crate::thermal::HeatConduction;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// Provenance written beside every run's output.
@@ -44,10 +48,27 @@ impl RunInfo {
 #[derive(Clone, Debug)]
 pub struct RunConfig {
     pub out_dir: PathBuf,
-    /// Allow writing into an existing non-empty directory.
+    /// Allow writing into an existing non-empty directory (a fresh run;
+    /// [`resume`] ignores it).
     pub force: bool,
     pub info: RunInfo,
+    /// When set (by a Ctrl-C / SIGTERM handler, or a test), the run writes a
+    /// checkpoint at the end of the current step and stops with
+    /// [`RunError::Interrupted`].
+    pub interrupt: Option<Arc<AtomicBool>>,
 }
+
+impl RunConfig {
+    /// Write into `out_dir`, without an interrupt flag.
+    pub fn new(out_dir: PathBuf, force: bool, info: RunInfo) -> Self {
+        RunConfig { out_dir, force, info, interrupt: None }
+    }
+}
+
+/// Most steps a run may take: beyond this, `time.end / Δt` comes from a
+/// typo (a `fixed_dt` of 1e-15 s, an end time of 1 s for a 30 µs impact),
+/// and the run would not finish in any useful time.
+pub const MAX_STEPS: Real = 1e9;
 
 /// What a finished run reports.
 #[derive(Clone, Debug)]
@@ -93,6 +114,17 @@ pub enum RunError {
     Plot(#[from] crate::io::PlotError),
     #[error("{error}\n  the state at failure is in {}; all earlier output is kept in {}", last_snapshot.display(), dir.display())]
     Unstable { error: SolverError, last_snapshot: PathBuf, dir: PathBuf },
+    #[error(transparent)]
+    Memory(#[from] MemoryError),
+    #[error("time step {dt:e} s: {message}")]
+    TimeStep { dt: Real, message: String },
+    #[error(transparent)]
+    Checkpoint(#[from] CheckpointError),
+    #[error(
+        "interrupted at step {step} (t = {time:.6e} s); the state is saved in {}; continue with `plugsim resume {}`",
+        checkpoint.display(), dir.display()
+    )]
+    Interrupted { step: u64, time: Real, checkpoint: PathBuf, dir: PathBuf },
 }
 
 /// Make sure `dir` can take a run: create it, or refuse if it holds files
@@ -109,11 +141,26 @@ pub fn prepare_output_dir(dir: &Path, force: bool) -> Result<(), RunError> {
         }
     } else {
         std::fs::create_dir_all(dir).map_err(|e| err(format!("cannot create: {e}")))?;
+        let probe = dir.join(".plugsim-write-test");
+        if let Err(e) = std::fs::write(&probe, b"") {
+            let _ = std::fs::remove_dir(dir); // leave nothing behind
+            return Err(err(format!("not writable: {e}")));
+        }
+        let _ = std::fs::remove_file(probe);
+        return Ok(());
     }
     let probe = dir.join(".plugsim-write-test");
     std::fs::write(&probe, b"").map_err(|e| err(format!("not writable: {e}")))?;
     let _ = std::fs::remove_file(probe);
     Ok(())
+}
+
+/// What must hold before a case is discretized: its estimated memory fits
+/// in the memory available (see [`crate::memory`]). Cheap: nothing is
+/// generated, so absurd grids are refused at once. Returns the estimate.
+pub fn preflight(case: &Case) -> Result<Footprint, RunError> {
+    let bodies = case.bodies.iter().map(|b| (b.name.as_str(), &b.rectangle));
+    Ok(crate::memory::guard(bodies, crate::memory::available_memory())?)
 }
 
 /// The simulation of a (resolved) case at t = 0: discretization, and
@@ -134,25 +181,56 @@ pub fn build_simulation(case: &Case) -> Result<Simulation, RunError> {
 
 /// The simulation without heat conduction and cracks.
 fn build_simulation_without_cracks(case: &Case) -> Result<Simulation, RunError> {
+    preflight(case)?;
     let model = Model::build(case.geometry.mode, &case.body_setups())?;
     let rule = case.time_step_rule();
-    if case.rigid_bodies.is_empty() {
-        return Ok(Simulation::new(model, rule));
+    let sim = if case.rigid_bodies.is_empty() {
+        Simulation::new(model, rule)
+    } else {
+        let bodies = case.rigid_bodies()?;
+        let slaves = SlaveSet::detect(&model.particles.x0, &model.particles.spacing, &SurfaceDetection::default())?;
+        let mut model = model;
+        slaves.mark_flags(&mut model.particles.flags)?;
+        let contact = ContactSystem::new(bodies, slaves, case.contact)?;
+        Simulation::with_contact(model, rule, contact)
+    };
+    check_time_step(&sim, case.time.end)?;
+    Ok(sim)
+}
+
+/// The step must be a positive number and the run must end in at most
+/// [`MAX_STEPS`] steps.
+fn check_time_step(sim: &Simulation, end: Real) -> Result<(), RunError> {
+    let dt = sim.dt;
+    if !(dt.is_finite() && dt > 0.0) {
+        let message = format!(
+            "not a positive number (wave speed {:e} m/s, smallest spacing {:e} m); check the materials' moduli and densities",
+            sim.model.max_wave_speed(),
+            sim.model.min_spacing()
+        );
+        return Err(RunError::TimeStep { dt, message });
     }
-    let bodies = case.rigid_bodies()?;
-    let slaves = SlaveSet::detect(&model.particles.x0, &model.particles.spacing, &SurfaceDetection::default())?;
-    let mut model = model;
-    slaves.mark_flags(&mut model.particles.flags)?;
-    let contact = ContactSystem::new(bodies, slaves, case.contact)?;
-    Ok(Simulation::with_contact(model, rule, contact))
+    let steps = end / dt;
+    if steps > MAX_STEPS {
+        let message = format!("{steps:.3e} steps to time.end = {end:e} s, more than the {MAX_STEPS:e} a run may take");
+        return Err(RunError::TimeStep { dt, message });
+    }
+    Ok(())
 }
 
 /// Progress reports to the caller.
 pub enum Progress<'a> {
-    /// The model is built; the loop is about to start.
-    Started { sim: &'a Simulation, steps_estimate: u64 },
+    /// A run continues from a checkpoint (before `Started`); `warnings`
+    /// says what the reader skipped or could not guarantee.
+    Resumed { sim: &'a Simulation, checkpoint: &'a Path, warnings: &'a [String] },
+    /// The model is built; the loop is about to start (or continue).
+    Started { sim: &'a Simulation, steps_estimate: u64, end: Real },
     /// Periodic, during the loop.
     Step { sim: &'a Simulation },
+    /// A checkpoint was written.
+    Checkpoint { sim: &'a Simulation, path: &'a Path },
+    /// The loop reached `time.end`; `sim` is the final state.
+    Finished { sim: &'a Simulation },
 }
 
 /// Build the model of `case`, run it to `time.end` writing into `cfg.out_dir`.
@@ -160,8 +238,10 @@ pub fn execute(case: &Case, cfg: &RunConfig, progress: &mut dyn FnMut(Progress))
     let case = case.resolved();
     let t_setup = Instant::now();
     // Build before touching the disk: a case that cannot be discretized leaves nothing behind.
-    let mut sim = build_simulation(&case)?;
+    let sim = build_simulation(&case)?;
     prepare_output_dir(&cfg.out_dir, cfg.force)?;
+    // A reused directory must not keep another run's checkpoints for `resume` to find.
+    crate::checkpoint::remove_all(&crate::checkpoint::directory(&cfg.out_dir))?;
     let write = |name: &str, text: String| -> Result<(), RunError> {
         let path = cfg.out_dir.join(name);
         std::fs::write(&path, text).map_err(|source| RunError::Io(IoError::Write { path, source }))
@@ -169,34 +249,152 @@ pub fn execute(case: &Case, cfg: &RunConfig, progress: &mut dyn FnMut(Progress))
     write("case.resolved.toml", case.resolved_toml())?;
     write("run_info.toml", toml::to_string_pretty(&cfg.info).unwrap_or_default())?;
     let rigid_names: Vec<String> = case.rigid_bodies.iter().map(|r| r.name.clone()).collect();
-    let mut out = OutputWriter::create(&cfg.out_dir, &case.output.fields, &rigid_names)?;
-    let setup_wall = t_setup.elapsed();
+    let out = OutputWriter::create(&cfg.out_dir, &case.output.fields, &rigid_names)?;
+    let schedule = Schedule {
+        next_snapshot: 0.0,
+        next_checkpoint: case.checkpoint.interval.unwrap_or(Real::INFINITY),
+        max_drift: 0.0,
+    };
+    time_loop(&case, sim, out, schedule, false, cfg, t_setup, progress)
+}
 
+/// Continue the run in `cfg.out_dir` from its newest readable checkpoint to
+/// `time.end`. The case is the one stored in the checkpoint; the snapshot
+/// series and `history.csv` continue where the checkpoint left them (rows and
+/// snapshots written after it are dropped), so the finished directory is the
+/// one an uninterrupted run would have written.
+pub fn resume(cfg: &RunConfig, progress: &mut dyn FnMut(Progress)) -> Result<RunSummary, RunError> {
+    let t_setup = Instant::now();
+    let (restored, mut warnings) = crate::checkpoint::read_latest(&cfg.out_dir)?;
+    let crate::checkpoint::Restored { path, writer, case, sim, progress: saved } = restored;
+    let this = crate::checkpoint::this_writer();
+    if writer != this {
+        warnings.push(format!(
+            "the checkpoint was written by {writer} and is continued by {this}: the result is bit-identical \
+             to an uninterrupted run only with the same build"
+        ));
+    }
+    let rigid_names: Vec<String> = case.rigid_bodies.iter().map(|r| r.name.clone()).collect();
+    let out = OutputWriter::resume(&cfg.out_dir, &case.output.fields, &rigid_names, &saved.snapshot_times, saved.history_bytes)?;
+    append_resume_record(cfg, &path, sim.step)?;
+    progress(Progress::Resumed { sim: &sim, checkpoint: &path, warnings: &warnings });
+    let schedule = Schedule { next_snapshot: saved.next_snapshot, next_checkpoint: saved.next_checkpoint, max_drift: saved.max_drift };
+    time_loop(&case, sim, out, schedule, true, cfg, t_setup, progress)
+}
+
+/// Add a `[[resumed]]` record (provenance of the continuing process) to
+/// `run_info.toml`.
+fn append_resume_record(cfg: &RunConfig, checkpoint: &Path, step: u64) -> Result<(), RunError> {
+    #[derive(serde::Serialize)]
+    struct Record<'a> {
+        checkpoint: String,
+        step: u64,
+        #[serde(flatten)]
+        info: &'a RunInfo,
+    }
+    #[derive(serde::Serialize)]
+    struct Resumed<'a> {
+        resumed: [Record<'a>; 1],
+    }
+    let record = Resumed { resumed: [Record { checkpoint: checkpoint.display().to_string(), step, info: &cfg.info }] };
+    let text = toml::to_string(&record).unwrap_or_default();
+    let path = cfg.out_dir.join("run_info.toml");
+    let fail = |source| RunError::Io(IoError::Write { path: path.clone(), source });
+    let mut file = std::fs::OpenOptions::new().append(true).create(true).open(&path).map_err(fail)?;
+    std::io::Write::write_all(&mut file, format!("\n{text}").as_bytes()).map_err(fail)
+}
+
+/// The run loop's own clocks, carried by checkpoints.
+struct Schedule {
+    /// Time of the next snapshot, s.
+    next_snapshot: Real,
+    /// Time of the next checkpoint by simulated time, s (infinite: none).
+    next_checkpoint: Real,
+    /// Largest |drift| at a history row so far.
+    max_drift: Real,
+}
+
+/// Write a checkpoint of the current state into the run's checkpoint
+/// directory (after the outputs of this step) and drop the oldest.
+fn save_checkpoint(case: &Case, sim: &Simulation, out: &OutputWriter, schedule: &Schedule, dir: &Path) -> Result<PathBuf, RunError> {
+    out.sync()?;
+    let progress = RunProgress {
+        snapshot_times: out.snapshot_times(),
+        history_bytes: out.history_bytes(),
+        next_snapshot: schedule.next_snapshot,
+        next_checkpoint: schedule.next_checkpoint,
+        max_drift: schedule.max_drift,
+    };
+    let dir = crate::checkpoint::directory(dir);
+    let path = dir.join(crate::checkpoint::file_name(sim.step));
+    crate::checkpoint::write(&path, sim, case, &progress)?;
+    crate::checkpoint::rotate(&dir, case.checkpoint.keep as usize)?;
+    Ok(path)
+}
+
+/// The time loop: outputs of the current state, then a checkpoint if one is
+/// due (or the run is interrupted), then a step. With `outputs_done`, the
+/// outputs of the first state are already on disk (a resumed run).
+#[allow(clippy::too_many_arguments)]
+fn time_loop(
+    case: &Case,
+    mut sim: Simulation,
+    mut out: OutputWriter,
+    mut schedule: Schedule,
+    mut outputs_done: bool,
+    cfg: &RunConfig,
+    t_setup: Instant,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<RunSummary, RunError> {
+    let setup_wall = t_setup.elapsed();
     let end = case.time.end;
     let interval = case.output.interval.expect("resolved");
     let steps_estimate = (end / sim.dt).ceil() as u64;
-    progress(Progress::Started { sim: &sim, steps_estimate });
+    progress(Progress::Started { sim: &sim, steps_estimate, end });
     let t_loop = Instant::now();
     let mut output_wall = Duration::ZERO;
-    let mut next_snapshot = 0.0;
-    let mut max_drift: Real = 0.0;
     let report_every = (steps_estimate / 200).max(1);
+    let (ckpt_interval, wall_interval) = (case.checkpoint.interval, case.checkpoint.wall_interval);
+    let mut last_checkpoint = Instant::now();
     loop {
         let done = sim.time >= end - 0.5 * sim.dt;
-        if sim.time >= next_snapshot - 0.5 * sim.dt || done {
-            let t = Instant::now();
-            out.snapshot(&sim)?;
-            next_snapshot += interval;
-            output_wall += t.elapsed();
+        if !outputs_done {
+            if sim.time >= schedule.next_snapshot - 0.5 * sim.dt || done {
+                let t = Instant::now();
+                out.snapshot(&sim)?;
+                schedule.next_snapshot += interval;
+                output_wall += t.elapsed();
+            }
+            if sim.step.is_multiple_of(case.output.history_every) || done {
+                let t = Instant::now();
+                out.history_row(&sim)?;
+                schedule.max_drift = schedule.max_drift.max(sim.energies.drift().abs());
+                output_wall += t.elapsed();
+            }
         }
-        if sim.step % case.output.history_every == 0 || done {
-            let t = Instant::now();
-            out.history_row(&sim)?;
-            max_drift = max_drift.max(sim.energies.drift().abs());
-            output_wall += t.elapsed();
-        }
+        outputs_done = false;
         if done {
             break;
+        }
+        let interrupted = cfg.interrupt.as_ref().is_some_and(|f| f.load(Ordering::SeqCst));
+        let by_time = sim.time >= schedule.next_checkpoint - 0.5 * sim.dt;
+        let by_wall = wall_interval > 0.0 && last_checkpoint.elapsed().as_secs_f64() >= wall_interval;
+        if interrupted || by_time || by_wall {
+            if by_time {
+                let every = ckpt_interval.unwrap_or(Real::INFINITY);
+                schedule.next_checkpoint += every;
+                if schedule.next_checkpoint <= sim.time {
+                    schedule.next_checkpoint = sim.time + every;
+                }
+            }
+            let t = Instant::now();
+            let path = save_checkpoint(case, &sim, &out, &schedule, &cfg.out_dir)?;
+            output_wall += t.elapsed();
+            last_checkpoint = Instant::now();
+            progress(Progress::Checkpoint { sim: &sim, path: &path });
+            if interrupted {
+                return Err(RunError::Interrupted { step: sim.step, time: sim.time, checkpoint: path, dir: cfg.out_dir.clone() });
+            }
         }
         let stepped = sim.step();
         out.crack_events(&sim)?;
@@ -205,11 +403,12 @@ pub fn execute(case: &Case, cfg: &RunConfig, progress: &mut dyn FnMut(Progress))
             out.history_row(&sim)?;
             return Err(RunError::Unstable { error, last_snapshot: last, dir: cfg.out_dir.clone() });
         }
-        if sim.step % report_every == 0 {
+        if sim.step.is_multiple_of(report_every) {
             progress(Progress::Step { sim: &sim });
         }
     }
-    let loop_wall = t_loop.elapsed() - output_wall;
+    let loop_wall = t_loop.elapsed().saturating_sub(output_wall);
+    progress(Progress::Finished { sim: &sim });
     let t = Instant::now();
     let plots = crate::output::plot_history(&cfg.out_dir)?;
     output_wall += t.elapsed();
@@ -241,7 +440,7 @@ pub fn execute(case: &Case, cfg: &RunConfig, progress: &mut dyn FnMut(Progress))
         output_wall,
         stage_timers: sim.timers.list(),
         energies: sim.energies,
-        max_drift,
+        max_drift: schedule.max_drift,
         out_dir: cfg.out_dir.clone(),
     })
 }

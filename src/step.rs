@@ -117,7 +117,7 @@ pub enum SolverError {
     },
     #[error(
         "particle {particle} moves at {speed:.3e} m/s, above the bound {bound:.3e} m/s, in step {step} \
-         (t = {time:.6e} s); the solution has gone unstable (time step too large?)"
+         (t = {time:.6e} s); the solution has gone unstable; likely cause: a time step above the stability limit"
     )]
     Runaway { particle: usize, speed: Real, bound: Real, step: u64, time: Real },
     #[error("crack growth failed in step {step} (t = {time:.6e} s): {source}")]
@@ -127,7 +127,28 @@ pub enum SolverError {
         step: u64,
         time: Real,
     },
+    #[error(
+        "energy blow-up in step {step} (t = {time:.6e} s): the energy balance totals {total:.4e} J, more than \
+         {factor} times the {input:.4e} J put in; the fastest particle is {particle} at {speed:.3e} m/s; \
+         likely cause: a time step above the stability limit (time.fixed_dt larger than the CFL step), \
+         or contact forces feeding energy in",
+        factor = ENERGY_BLOWUP_FACTOR
+    )]
+    EnergyBlowUp { total: Real, input: Real, particle: usize, speed: Real, step: u64, time: Real },
 }
+
+/// A run stops with [`SolverError::EnergyBlowUp`] when its energy balance
+/// ([`Energies::total`]) exceeds this multiple of the energy put in
+/// ([`Simulation::input_energy`]). Stable runs keep the balance within a
+/// few percent (SPEC §5 warns beyond that), so 2 is far outside any
+/// integration error; an instability grows exponentially and crosses it
+/// within a few e-foldings, usually steps before speeds reach the runaway
+/// bound or values overflow, so the run stops with the most telling message
+/// while its last snapshot still shows where it started. Runs with no input
+/// energy are not checked this way (the other checks still apply). Tests:
+/// `unstable_fixed_dt_stops_with_a_message` and
+/// `a_driven_punch_is_not_an_energy_blow_up` (tests/robustness.rs).
+pub const ENERGY_BLOWUP_FACTOR: Real = 2.0;
 
 /// The running simulation.
 #[derive(Clone, Debug)]
@@ -241,6 +262,7 @@ impl Simulation {
         self.step += 1;
         self.diagnose()?;
         self.energies.kinetic = self.full_step_kinetic_energy();
+        self.check_energy()?;
         let t4 = Instant::now();
         self.timers.contact += t0 - tc;
         self.timers.integration += t1 - t0;
@@ -471,11 +493,20 @@ impl Simulation {
         let healthy = (&p.v, &p.f_int)
             .into_par_iter()
             .all(|(v, f)| v.norm_squared() <= bound2 && f.x.is_finite() && f.y.is_finite());
-        if healthy {
+        let q = &self.model.quad;
+        let scalars = [("plastic strain", &q.eps_p), ("temperature", &q.temperature), ("damage", &q.damage)];
+        let scalars_ok = (&q.eps_p, &q.temperature, &q.damage)
+            .into_par_iter()
+            .all(|(a, b, c)| a.is_finite() && b.is_finite() && c.is_finite());
+        if healthy && scalars_ok {
             return Ok(());
         }
         if let Some(q) = self.model.quad.tau.par_iter().position_first(|t: &Tensor3| !t.iter().all(|x| x.is_finite())) {
             return Err(SolverError::NonFinite { field: "stress", location: "quadrature point", index: q, step, time });
+        }
+        if let Some(k) = (0..q.len()).into_par_iter().position_first(|k| scalars.iter().any(|(_, c)| !c[k].is_finite())) {
+            let field = scalars.iter().find(|(_, c)| !c[k].is_finite()).map_or("state", |(f, _)| f);
+            return Err(SolverError::NonFinite { field, location: "quadrature point", index: k, step, time });
         }
         if let Some(i) = p.v.par_iter().position_first(|v| !v.x.is_finite() || !v.y.is_finite()) {
             return Err(SolverError::NonFinite { field: "velocity", location: "particle", index: i, step, time });
@@ -485,6 +516,36 @@ impl Simulation {
         }
         if let Some(i) = p.v.par_iter().position_first(|v| v.norm_squared() > bound2) {
             return Err(SolverError::Runaway { particle: i, speed: p.v[i].norm(), bound: self.speed_bound, step, time });
+        }
+        Ok(())
+    }
+}
+
+impl Simulation {
+    /// Energy put into the run so far, J: the initial kinetic energy, plus
+    /// the work of whatever drives the rigid bodies whose velocity is
+    /// prescribed (it holds their velocity against the contact reaction, so
+    /// it does minus the reaction's work on them).
+    pub fn input_energy(&self) -> Real {
+        let driven: Real = self.contact.as_ref().map_or(0.0, |c| {
+            (0..c.bodies.len())
+                .filter(|&b| c.bodies[b].prescribed_velocity.is_some())
+                .filter_map(|b| c.sample(b))
+                .map(|s| -s.work_on_body)
+                .sum()
+        });
+        self.energies.initial_kinetic + driven
+    }
+
+    /// Stop on an energy balance above [`ENERGY_BLOWUP_FACTOR`] times the
+    /// input energy (or not finite), naming the fastest particle.
+    fn check_energy(&self) -> Result<(), SolverError> {
+        let (total, input) = (self.energies.total(), self.input_energy());
+        if input > 0.0 && (total.is_nan() || total > ENERGY_BLOWUP_FACTOR * input) {
+            let v = &self.model.particles.v;
+            let particle = (0..v.len()).fold(0, |best, i| if v[i].norm_squared() > v[best].norm_squared() { i } else { best });
+            let speed = v.get(particle).map_or(0.0, |v| v.norm());
+            return Err(SolverError::EnergyBlowUp { total, input, particle, speed, step: self.step, time: self.time });
         }
         Ok(())
     }

@@ -69,7 +69,8 @@ pub use search::{search_rigid_polygon, search_rigid_polygon_brute_force, Project
 pub use slave::{MasterFeature, Pairing, SlaveSet};
 pub use surface::{detect_surface, SurfaceDetection};
 pub use system::{
-    ActiveContact, BodySample, ContactParameters, ContactSystem, StepInput, StepReport,
+    ActiveContact, BodySample, ContactAccumulators, ContactParameters, ContactSystem, StepInput,
+    StepReport,
 };
 
 use crate::math::Real;

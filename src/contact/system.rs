@@ -272,6 +272,20 @@ pub struct StepReport {
     pub iterations: u32,
 }
 
+/// Per-body running sums of a [`ContactSystem`] (see
+/// [`ContactSystem::accumulators`]), one entry per rigid body.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ContactAccumulators {
+    /// Cumulative work of each body's contact forces on the particles, J.
+    pub work_on_particles: Vec<Real>,
+    /// Cumulative work of the reactions on each body, J.
+    pub work_on_body: Vec<Real>,
+    /// Reaction on each body in the last step, N.
+    pub reaction: Vec<Vec2>,
+    /// Active contacts per body in the last step.
+    pub active_per_body: Vec<usize>,
+}
+
 /// Contact of the deformable particles with rigid bodies (SPEC §8).
 #[derive(Clone, Debug)]
 pub struct ContactSystem {
@@ -367,6 +381,46 @@ impl ContactSystem {
             work_on_body: self.work_on_body.get(b).copied().unwrap_or(0.0),
             active_contacts: self.active_per_body.get(b).copied().unwrap_or(0),
         })
+    }
+
+    /// What the contact carries from one step to the next besides the
+    /// bodies and the slave set: the cumulative work and the last step's
+    /// reactions and contact counts (the history reports them). A checkpoint
+    /// stores these; everything else is rebuilt or recomputed each step.
+    pub fn accumulators(&self) -> ContactAccumulators {
+        ContactAccumulators {
+            work_on_particles: self.work_on_particles.clone(),
+            work_on_body: self.work_on_body.clone(),
+            reaction: self.reaction.clone(),
+            active_per_body: self.active_per_body.clone(),
+        }
+    }
+
+    /// Put back what [`Self::accumulators`] returned (resuming a run). Each
+    /// list must have one entry per body.
+    pub fn restore_accumulators(&mut self, a: ContactAccumulators) -> Result<(), ContactError> {
+        let nb = self.bodies.len();
+        let lens = [
+            ("work_on_particles", a.work_on_particles.len()),
+            ("work_on_body", a.work_on_body.len()),
+            ("reaction", a.reaction.len()),
+            ("active_per_body", a.active_per_body.len()),
+        ];
+        for (field, found) in lens {
+            if found != nb {
+                return Err(ContactError::LengthMismatch {
+                    field,
+                    expected: nb,
+                    found,
+                });
+            }
+        }
+        self.work_on_particles = a.work_on_particles;
+        self.work_on_body = a.work_on_body;
+        self.reaction = a.reaction;
+        self.active_per_body = a.active_per_body;
+        self.pending = None;
+        Ok(())
     }
 
     fn resize_per_body(&mut self) {

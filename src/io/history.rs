@@ -22,6 +22,8 @@ pub struct HistoryWriter {
     columns: Vec<String>,
     /// Reused row buffer.
     line: String,
+    /// Bytes in the file: header and every row written.
+    bytes: u64,
 }
 
 impl HistoryWriter {
@@ -63,6 +65,79 @@ impl HistoryWriter {
             file,
             columns: columns.iter().map(|c| c.to_string()).collect(),
             line: String::new(),
+            bytes: header.len() as u64,
+        })
+    }
+
+    /// Continues an existing file (a resumed run): checks that its header
+    /// names `columns`, cuts it to its first `keep` bytes (the rows written
+    /// up to the checkpoint; later rows are dropped) and appends from there.
+    /// `keep` must end at a line break and leave the header.
+    pub fn continue_at(path: &Path, columns: &[&str], keep: u64) -> Result<Self, IoError> {
+        let read_error = |source| IoError::Read {
+            path: path.to_path_buf(),
+            source,
+        };
+        let parse_error = |message: String| IoError::Parse {
+            path: path.to_path_buf(),
+            line: 1,
+            message,
+        };
+        let mut file = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(path)
+            .map_err(read_error)?;
+        let header = format!("{}\n", columns.join(","));
+        let mut head = vec![0u8; header.len()];
+        std::io::Read::read_exact(&mut file, &mut head)
+            .map_err(|_| parse_error("shorter than its header".into()))?;
+        if head != header.as_bytes() {
+            return Err(parse_error(format!(
+                "header differs from the run's columns `{}`",
+                columns.join(",")
+            )));
+        }
+        let len = file.metadata().map_err(read_error)?.len();
+        if keep < header.len() as u64 || keep > len {
+            return Err(parse_error(format!(
+                "has {len} bytes, but {keep} were written up to the checkpoint (the file was cut or replaced)"
+            )));
+        }
+        let mut last = [0u8; 1];
+        std::io::Seek::seek(&mut file, std::io::SeekFrom::Start(keep - 1)).map_err(read_error)?;
+        std::io::Read::read_exact(&mut file, &mut last).map_err(read_error)?;
+        if last[0] != b'\n' {
+            return Err(parse_error(format!(
+                "byte {keep} is not the end of a row (the file was changed)"
+            )));
+        }
+        let write_error = |source| IoError::Write {
+            path: path.to_path_buf(),
+            source,
+        };
+        file.set_len(keep).map_err(write_error)?;
+        std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0)).map_err(write_error)?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            file,
+            columns: columns.iter().map(|c| c.to_string()).collect(),
+            line: String::new(),
+            bytes: keep,
+        })
+    }
+
+    /// Bytes in the file so far (header and rows).
+    pub fn bytes(&self) -> u64 {
+        self.bytes
+    }
+
+    /// Hands the rows written so far to the disk (`fsync`), so that they
+    /// survive a power loss, not only a crash of the process.
+    pub fn sync(&self) -> Result<(), IoError> {
+        self.file.sync_data().map_err(|source| IoError::Write {
+            path: self.path.clone(),
+            source,
         })
     }
 
@@ -92,7 +167,9 @@ impl HistoryWriter {
             .map_err(|source| IoError::Write {
                 path: self.path.clone(),
                 source,
-            })
+            })?;
+        self.bytes += self.line.len() as u64;
+        Ok(())
     }
 
     /// The column names, in order.

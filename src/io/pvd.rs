@@ -43,6 +43,17 @@ impl PvdSeries {
         Ok(series)
     }
 
+    /// A series that continues with `entries` already in it (a resumed
+    /// run), written immediately (replacing any existing file).
+    pub fn with_entries(path: &Path, entries: Vec<PvdEntry>) -> Result<Self, IoError> {
+        let series = Self {
+            path: path.to_path_buf(),
+            entries,
+        };
+        series.write()?;
+        Ok(series)
+    }
+
     /// Adds the data set `file` (relative to the `.pvd` file's directory)
     /// as part `part` at time `time` (s), then rewrites the collection.
     ///
