@@ -14,6 +14,11 @@ pub const BUILTIN_CASES: &[(&str, &str, &str)] = &[
         "elastic steel disc, struck centre, axisymmetric (seconds)",
     ),
     (
+        "borvik-1-plane-strain",
+        include_str!("../cases/borvik-1-plane-strain.toml"),
+        "Borvik Case I (298 m/s, 11.1 mm Weldox), plane strain, coarse, effective-strain cracks",
+    ),
+    (
         "borvik-1-nofracture",
         include_str!("../cases/borvik-1-nofracture.toml"),
         "Borvik Case I (298 m/s, 11.1 mm Weldox), plane strain, coarse, no fracture",

@@ -328,3 +328,72 @@ pub fn plot_history(dir: &Path) -> Result<Vec<PathBuf>, crate::run::RunError> {
     crate::io::save_line_plot(&path, &plot)?;
     Ok(vec![path])
 }
+
+/// A field plot of the deformed bodies (particles at `x = X + u(X)`, in mm),
+/// coloured by a projected quadrature field, with the crack faces drawn over
+/// them; `window` limits the view to `[x_min, x_max, y_min, y_max]` (m) in
+/// the reference configuration.
+pub fn field_plot(
+    sim: &Simulation,
+    field: &str,
+    window: Option<[Real; 4]>,
+) -> Option<crate::io::FieldPlot> {
+    let m = &sim.model;
+    let q = &m.quad;
+    let (values, label): (Vec<Real>, &str) = match field {
+        "effective_stress" => {
+            (m.project(|k| von_mises(&(q.tau[k] / q.f[k].determinant())) * 1e-6), "effective stress (MPa)")
+        }
+        "temperature" => (m.project(|k| q.temperature[k]), "temperature (K)"),
+        "plastic_strain" => (m.project(|k| q.eps_p[k]), "effective plastic strain"),
+        "damage" => (m.project(|k| q.damage[k]), "Johnson-Cook damage"),
+        _ => return None,
+    };
+    let u = m.physical(&m.particles.u);
+    let keep = |i: usize| {
+        let x = m.particles.x0[i];
+        window.is_none_or(|w| x.x >= w[0] && x.x <= w[1] && x.y >= w[2] && x.y <= w[3])
+    };
+    let idx: Vec<usize> = (0..m.particles.len()).filter(|&i| keep(i)).collect();
+    let lines = sim
+        .cracks
+        .as_ref()
+        .map(|c| {
+            c.cracks
+                .iter()
+                .flat_map(|k| k.face_polylines(m))
+                .map(|l| l.iter().map(|p| (p.x * 1e3, p.y * 1e3)).collect())
+                .collect()
+        })
+        .unwrap_or_default();
+    Some(crate::io::FieldPlot {
+        title: format!("{label} at t = {:.1} us", sim.time * 1e6),
+        x_label: "x (mm)".into(),
+        y_label: "y (mm)".into(),
+        points: idx.iter().map(|&i| ((m.particles.x0[i].x + u[i].x) * 1e3, (m.particles.x0[i].y + u[i].y) * 1e3)).collect(),
+        values: idx.iter().map(|&i| values[i]).collect(),
+        value_label: label.into(),
+        lines,
+    })
+}
+
+/// End-of-run field plots (`effective_stress.png`, `temperature.png`) of the
+/// region around the first rigid body (±2 projectile widths), or of
+/// everything without one.
+pub fn plot_fields(sim: &Simulation, dir: &Path) -> Result<Vec<PathBuf>, crate::run::RunError> {
+    let window = sim.contact.as_ref().and_then(|c| c.bodies.first()).map(|b| {
+        let (lo, hi) = b.outline().iter().fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), v| (lo.min(v.x), hi.max(v.x)));
+        let w = hi - lo;
+        let cx = b.position.x + 0.5 * (lo + hi);
+        [cx - 1.5 * w, cx + 1.5 * w, Real::NEG_INFINITY, Real::INFINITY]
+    });
+    let mut written = Vec::new();
+    for field in ["effective_stress", "temperature"] {
+        if let Some(plot) = field_plot(sim, field, window) {
+            let path = dir.join(format!("{field}.png"));
+            crate::io::save_field_plot(&path, &plot)?;
+            written.push(path);
+        }
+    }
+    Ok(written)
+}

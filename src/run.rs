@@ -410,7 +410,8 @@ fn time_loop(
     let loop_wall = t_loop.elapsed().saturating_sub(output_wall);
     progress(Progress::Finished { sim: &sim });
     let t = Instant::now();
-    let plots = crate::output::plot_history(&cfg.out_dir)?;
+    let mut plots = crate::output::plot_history(&cfg.out_dir)?;
+    plots.extend(crate::output::plot_fields(&sim, &cfg.out_dir)?);
     output_wall += t.elapsed();
     let (cracks, separation) = match &sim.cracks {
         Some(c) => (
