@@ -19,6 +19,11 @@ pub const BUILTIN_CASES: &[(&str, &str, &str)] = &[
         "Borvik Case I (298 m/s, 11.1 mm Weldox), plane strain, coarse, effective-strain cracks",
     ),
     (
+        "borvik-1-plane-strain-fine",
+        include_str!("../cases/borvik-1-plane-strain-fine.toml"),
+        "the same with [RL10]'s fine discretization (48 rows, 46,032 particles)",
+    ),
+    (
         "borvik-1-nofracture",
         include_str!("../cases/borvik-1-nofracture.toml"),
         "Borvik Case I (298 m/s, 11.1 mm Weldox), plane strain, coarse, no fracture",
