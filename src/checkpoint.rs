@@ -9,7 +9,11 @@
 //! shape-function tables, the force gather, the body index ranges, time,
 //! step, `Δt`, the speed bound, the energy account, the contact force of the
 //! last step, the rigid bodies' positions and velocities, the slave set with
-//! each slave's last pairing and the contact's running sums, and where the
+//! each slave's last pairing and the contact's running sums, the time
+//! accumulated toward the next heat conduction (`heat_pending`, with
+//! `heat_every`), whether constraints are driven, the crack growth (every
+//! crack's reference polyline with its split children, tip, offset and
+//! times, the event log, the rows built with a reduced basis), and where the
 //! run's outputs stand (snapshot times, the length of `history.csv`, the next
 //! snapshot and checkpoint times, the largest drift so far). The case itself
 //! is stored as resolved TOML text with the built-in materials written out,
@@ -32,19 +36,20 @@
 //! ```
 //! The magic, the version and the writer come first in every format version,
 //! so a reader can always say which version and which plugsim wrote a file
-//! it cannot read. Version 1 has the sections `META`, `PART`, `QUAD`, `QTAB`,
-//! `PTAB`, `GATH`, `BODY`, `FCON`, `CONT` (only with rigid bodies) and the
-//! terminator `END!`. Inside a section, a column is its element count (u64)
+//! it cannot read. Version 2 has the sections `META`, `PART`, `QUAD`, `QTAB`,
+//! `PTAB`, `GATH`, `BODY`, `FCON`, `CONT` (only with rigid bodies), `CRAK`
+//! (only with a fracture criterion) and the terminator `END!`. Inside a section, a column is its element count (u64)
 //! followed by the elements; a `Vec2` is x, y and a `Tensor3` its nine
 //! components column by column, each as the IEEE-754 bits of the `f64`, so
 //! values round-trip exactly. Adding state (the crack polylines, new
 //! particle fields) means a new section or a new column, a bump of
 //! [`FORMAT_VERSION`] and a test; a reader refuses every version but its own
-//! ([`CheckpointError::Version`]). Crack growth, for example, adds a `CRAK`
-//! section (the polylines in the reference configuration, their tips and
-//! the particles on each face) to `write_payload`, `sections` and `restore`;
-//! its split particles and patched tables are already carried by `PART`,
-//! `QTAB`, `PTAB` and `GATH`. Fields added to the particle or quadrature
+//! ([`CheckpointError::Version`]). The `CRAK` section, for example, holds
+//! the crack polylines, tips and event log (`crack_bytes`,
+//! `restore_cracks`); the split particles, their face sides and the patched
+//! tables are carried by `PART`, `QTAB`, `PTAB` and `GATH`. Heat conduction
+//! keeps no state between steps and is rebuilt from the case and the model
+//! ([`Case::heat_conduction_for`], as a fresh run builds it). Fields added to the particle or quadrature
 //! stores fail to compile in `write_payload` (exhaustive destructuring)
 //! until they are stored, and `tests/checkpoint.rs` compares the whole
 //! `Simulation` of a resumed run with an uninterrupted one, so state kept
@@ -1496,6 +1501,8 @@ fn restore_cracks(all: &Sections, case: &Case, model: &Model) -> Result<Option<C
             || m < 2
             || [tag.len(), left.len(), right.len()] != [m; 3]
             || !(offset.is_finite() && offset >= 0.0)
+            || !nucleated.0.is_finite()
+            || arrested.is_some_and(|a| !a.0.is_finite())
             || x0.iter().any(|p| !(p.x.is_finite() && p.y.is_finite()))
         {
             return Err(format!("crack {k} is inconsistent"));
