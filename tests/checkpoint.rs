@@ -271,19 +271,31 @@ fn resumed_contact_run_is_bit_identical_to_an_uninterrupted_one() {
 fn resumed_fracture_run_is_bit_identical_to_an_uninterrupted_one() {
     let case = case(BORVIK_FRACTURE, FRACTURE_SETS);
     let (from, end) = kill_and_resume("fracture", &case, FRACTURE_STOP);
-    assert!(case.heat_conduction(), "conduction is on across the checkpoint");
+    assert!(
+        case.heat_conduction(),
+        "conduction is on across the checkpoint"
+    );
     assert!(from.heat_pending > 0.0, "heat is pending at the checkpoint");
     let at = from.cracks.as_ref().expect("fracture is on");
     let final_events = &end.cracks.as_ref().unwrap().events;
-    assert!(!at.cracks.is_empty(), "a crack nucleated before the checkpoint");
+    assert!(
+        !at.cracks.is_empty(),
+        "a crack nucleated before the checkpoint"
+    );
     assert!(
         final_events.len() > at.events.len()
-            && final_events[at.events.len()..].iter().any(|e| e.crack < at.cracks.len()),
+            && final_events[at.events.len()..]
+                .iter()
+                .any(|e| e.crack < at.cracks.len()),
         "a crack of the checkpoint grew after it"
     );
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("checkpoint-fracture-resumed");
     let log = std::fs::read_to_string(dir.join("cracks.csv")).unwrap();
-    assert_eq!(log.lines().count(), 1 + final_events.len(), "one row per event");
+    assert_eq!(
+        log.lines().count(),
+        1 + final_events.len(),
+        "one row per event"
+    );
     let pvd = std::fs::read_to_string(dir.join("results.pvd")).unwrap();
     assert_eq!(
         pvd.matches("part=\"1\"").count(),
@@ -322,7 +334,11 @@ fn crack_state_round_trips_bit_for_bit() {
     let mut restored = checkpoint::read(&path).unwrap();
     let cracks = restored.sim.cracks.as_mut().expect("fracture is on");
     assert!(cracks.cracks.is_empty(), "no crack yet at step 2");
-    let odd = [f64::from_bits(0x7ff8_dead_beef_0001), -0.0, f64::NEG_INFINITY];
+    let odd = [
+        f64::from_bits(0x7ff8_dead_beef_0001),
+        -0.0,
+        f64::NEG_INFINITY,
+    ];
     for (k, value) in odd.into_iter().enumerate() {
         cracks.events.push(plugsim::fracture::CrackEvent {
             time: -0.0,
@@ -337,8 +353,14 @@ fn crack_state_round_trips_bit_for_bit() {
     cracks.cracks.push(plugsim::fracture::Crack {
         id: 0,
         vertices: vec![
-            plugsim::fracture::CrackVertex { x0: restored.sim.model.particles.x0[0], faces: None },
-            plugsim::fracture::CrackVertex { x0: restored.sim.model.particles.x0[1], faces: Some((0, 1)) },
+            plugsim::fracture::CrackVertex {
+                x0: restored.sim.model.particles.x0[0],
+                faces: None,
+            },
+            plugsim::fracture::CrackVertex {
+                x0: restored.sim.model.particles.x0[1],
+                faces: Some((0, 1)),
+            },
         ],
         tip: Some(1),
         offset: 1e-6,
@@ -349,9 +371,18 @@ fn crack_state_round_trips_bit_for_bit() {
     checkpoint::write(&again, &restored.sim, &restored.case, &restored.progress).unwrap();
     let back = checkpoint::read(&again).unwrap();
     let bytes = |s: &Simulation| checkpoint::state_bytes(s, &restored.case, &restored.progress);
-    assert!(bytes(&back.sim) == bytes(&restored.sim), "state bytes differ after a round trip");
+    assert!(
+        bytes(&back.sim) == bytes(&restored.sim),
+        "state bytes differ after a round trip"
+    );
     let bits = |s: &Simulation| {
-        s.cracks.as_ref().unwrap().events.iter().map(|e| (e.time.to_bits(), e.value.to_bits())).collect::<Vec<_>>()
+        s.cracks
+            .as_ref()
+            .unwrap()
+            .events
+            .iter()
+            .map(|e| (e.time.to_bits(), e.value.to_bits()))
+            .collect::<Vec<_>>()
     };
     assert_eq!(bits(&back.sim), bits(&restored.sim));
 }
@@ -415,8 +446,13 @@ fn version_1_checkpoint_is_refused_naming_both_versions() {
         e.contains("format version 1 ") && e.contains("reads format version 2"),
         "{e}"
     );
-    let e = resume(&config(&dir, None), &mut |_| {}).unwrap_err().to_string();
-    assert!(e.contains("format version 1 ") && e.contains("format version 2"), "{e}");
+    let e = resume(&config(&dir, None), &mut |_| {})
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("format version 1 ") && e.contains("format version 2"),
+        "{e}"
+    );
 }
 
 #[test]
