@@ -595,6 +595,21 @@ impl Case {
         })
     }
 
+    /// The heat conduction of a run of this case on `model` (`None` where
+    /// [`Case::heat_conduction`] is off), with `heat.safety_factor`. The one
+    /// place a run attaches conduction: a fresh run at t = 0 and a run
+    /// resumed from a checkpoint (conduction keeps no state between steps,
+    /// so it is rebuilt from the model).
+    pub fn heat_conduction_for(
+        &self,
+        model: &crate::model::Model,
+    ) -> Result<Option<crate::thermal::HeatConduction>, crate::thermal::HeatError> {
+        if !self.heat_conduction() {
+            return Ok(None);
+        }
+        crate::thermal::HeatConduction::new(model, self.heat.safety_factor).map(Some)
+    }
+
     /// TOML text of [`Case::resolved`].
     pub fn resolved_toml(&self) -> String {
         toml::to_string_pretty(&self.resolved()).unwrap_or_else(|e| format!("# could not serialize the case: {e}\n"))

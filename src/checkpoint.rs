@@ -9,7 +9,11 @@
 //! shape-function tables, the force gather, the body index ranges, time,
 //! step, `Δt`, the speed bound, the energy account, the contact force of the
 //! last step, the rigid bodies' positions and velocities, the slave set with
-//! each slave's last pairing and the contact's running sums, and where the
+//! each slave's last pairing and the contact's running sums, the time
+//! accumulated toward the next heat conduction (`heat_pending`, with
+//! `heat_every`), whether constraints are driven, the crack growth (every
+//! crack's reference polyline with its split children, tip, offset and
+//! times, the event log, the rows built with a reduced basis), and where the
 //! run's outputs stand (snapshot times, the length of `history.csv`, the next
 //! snapshot and checkpoint times, the largest drift so far). The case itself
 //! is stored as resolved TOML text with the built-in materials written out,
@@ -32,19 +36,20 @@
 //! ```
 //! The magic, the version and the writer come first in every format version,
 //! so a reader can always say which version and which plugsim wrote a file
-//! it cannot read. Version 1 has the sections `META`, `PART`, `QUAD`, `QTAB`,
-//! `PTAB`, `GATH`, `BODY`, `FCON`, `CONT` (only with rigid bodies) and the
-//! terminator `END!`. Inside a section, a column is its element count (u64)
+//! it cannot read. Version 2 has the sections `META`, `PART`, `QUAD`, `QTAB`,
+//! `PTAB`, `GATH`, `BODY`, `FCON`, `CONT` (only with rigid bodies), `CRAK`
+//! (only with a fracture criterion) and the terminator `END!`. Inside a section, a column is its element count (u64)
 //! followed by the elements; a `Vec2` is x, y and a `Tensor3` its nine
 //! components column by column, each as the IEEE-754 bits of the `f64`, so
 //! values round-trip exactly. Adding state (the crack polylines, new
 //! particle fields) means a new section or a new column, a bump of
 //! [`FORMAT_VERSION`] and a test; a reader refuses every version but its own
-//! ([`CheckpointError::Version`]). Crack growth, for example, adds a `CRAK`
-//! section (the polylines in the reference configuration, their tips and
-//! the particles on each face) to `write_payload`, `sections` and `restore`;
-//! its split particles and patched tables are already carried by `PART`,
-//! `QTAB`, `PTAB` and `GATH`. Fields added to the particle or quadrature
+//! ([`CheckpointError::Version`]). The `CRAK` section, for example, holds
+//! the crack polylines, tips and event log (`crack_bytes`,
+//! `restore_cracks`); the split particles, their face sides and the patched
+//! tables are carried by `PART`, `QTAB`, `PTAB` and `GATH`. Heat conduction
+//! keeps no state between steps and is rebuilt from the case and the model
+//! ([`Case::heat_conduction_for`], as a fresh run builds it). Fields added to the particle or quadrature
 //! stores fail to compile in `write_payload` (exhaustive destructuring)
 //! until they are stored, and `tests/checkpoint.rs` compares the whole
 //! `Simulation` of a resumed run with an uninterrupted one, so state kept
@@ -65,6 +70,10 @@
 
 use crate::case::{Case, MaterialSpec};
 use crate::contact::{ContactAccumulators, ContactSystem, MasterFeature, Pairing, SlaveSet};
+use crate::fracture::rows::Basis;
+use crate::fracture::{
+    Crack, CrackEvent, CrackGrowth, CrackVertex, Criterion, EventKind, FractureParameters,
+};
 use crate::material::Material;
 use crate::math::{Real, Tensor3, Vec2};
 use crate::model::{BodyInfo, Gather, Model};
@@ -79,7 +88,10 @@ use std::path::{Path, PathBuf};
 /// First bytes of every checkpoint file.
 pub const MAGIC: [u8; 8] = *b"PLUGCKPT";
 /// The format this build writes and the only one it reads.
-pub const FORMAT_VERSION: u32 = 1;
+///
+/// Version 1 (before heat conduction and crack growth were carried) lacks
+/// the conduction clock and the `CRAK` section; version 2 adds them.
+pub const FORMAT_VERSION: u32 = 2;
 /// Subdirectory of a run's output directory that holds its checkpoints.
 pub const DIRECTORY: &str = "checkpoints";
 /// File name extension of a checkpoint.
@@ -484,6 +496,9 @@ fn meta_bytes(
     e.f64(*max_drift)?;
     e.u64(sim.model.particles.len() as u64)?;
     e.u64(sim.model.quad.len() as u64)?;
+    e.u64(sim.heat_every)?;
+    e.f64(sim.heat_pending)?;
+    e.u32(u32::from(sim.driven_constraints))?;
     Ok(e.w)
 }
 
@@ -557,6 +572,110 @@ fn contact_bytes(c: &ContactSystem) -> std::io::Result<Vec<u8>> {
             .map(|&a| a as u64)
             .collect::<Vec<_>>(),
     ))?;
+    Ok(e.w)
+}
+
+fn basis_tag(b: Basis) -> u8 {
+    match b {
+        Basis::Bilinear => 0,
+        Basis::Linear => 1,
+        Basis::Constant => 2,
+    }
+}
+
+/// The `CRAK` section: the crack-growth parameters, each crack (header,
+/// then its vertices as columns: reference position, face tag 0 none /
+/// 1 split, left child, right child), the event log as columns (the
+/// particles of all events in one column with row offsets) and the rows
+/// built with a reduced basis (row, basis tag). The binned segments and the
+/// search grid are derived and rebuilt on reading
+/// ([`CrackGrowth::from_state`]).
+fn crack_bytes(c: &CrackGrowth) -> std::io::Result<Vec<u8>> {
+    let mut e = Enc { w: Vec::new() };
+    let FractureParameters {
+        criterion,
+        critical_effective_strain,
+        critical_damage,
+        radius_factor,
+        fan_angle,
+        offset_ratio,
+        nucleation_distance_factor,
+    } = c.params;
+    e.u32(match criterion {
+        Criterion::EffectiveStrain => 0,
+        Criterion::Damage => 1,
+        Criterion::None => 2,
+    })?;
+    for v in [
+        critical_effective_strain,
+        critical_damage,
+        radius_factor,
+        fan_angle,
+        offset_ratio,
+        nucleation_distance_factor,
+    ] {
+        e.f64(v)?;
+    }
+    e.u64(c.cracks.len() as u64)?;
+    for k in &c.cracks {
+        let Crack {
+            id,
+            vertices,
+            tip,
+            offset,
+            nucleated,
+            arrested,
+        } = k;
+        e.u64(*id as u64)?;
+        e.u64(tip.map_or(u64::MAX, |t| t as u64))?;
+        e.f64(*offset)?;
+        e.f64(nucleated.0)?;
+        e.u64(nucleated.1)?;
+        e.u32(u32::from(arrested.is_some()))?;
+        let (at, at_step) = arrested.unwrap_or((0.0, 0));
+        e.f64(at)?;
+        e.u64(at_step)?;
+        let x0: Vec<Vec2> = vertices.iter().map(|v| v.x0).collect();
+        let tag: Vec<u8> = vertices.iter().map(|v| u8::from(v.faces.is_some())).collect();
+        let left: Vec<u32> = vertices.iter().map(|v| v.faces.map_or(0, |f| f.0)).collect();
+        let right: Vec<u32> = vertices.iter().map(|v| v.faces.map_or(0, |f| f.1)).collect();
+        e.col(&Col::V2(&x0))?;
+        e.col(&Col::U8(&tag))?;
+        e.col(&Col::U32(&left))?;
+        e.col(&Col::U32(&right))?;
+    }
+    let ev = &c.events;
+    let mut offsets = vec![0u64];
+    let mut particles = Vec::new();
+    for CrackEvent { particles: p, .. } in ev {
+        particles.extend(p.iter().map(|&i| i as u64));
+        offsets.push(particles.len() as u64);
+    }
+    let time: Vec<Real> = ev.iter().map(|x| x.time).collect();
+    let step: Vec<u64> = ev.iter().map(|x| x.step).collect();
+    let crack: Vec<u64> = ev.iter().map(|x| x.crack as u64).collect();
+    let kind: Vec<u8> = ev
+        .iter()
+        .map(|x| match x.kind {
+            EventKind::Nucleate => 0,
+            EventKind::Propagate => 1,
+            EventKind::Arrest => 2,
+        })
+        .collect();
+    let value: Vec<Real> = ev.iter().map(|x| x.value).collect();
+    e.col(&Col::F64(&time))?;
+    e.col(&Col::U64(&step))?;
+    e.col(&Col::U64(&crack))?;
+    e.col(&Col::U8(&kind))?;
+    e.col(&Col::U64(&offsets))?;
+    e.col(&Col::U64(&particles))?;
+    e.col(&Col::F64(&value))?;
+    for rows in [&c.reduced_quadrature_rows, &c.reduced_particle_rows] {
+        let keys: Vec<u64> = rows.keys().map(|&k| k as u64).collect();
+        let bases: Vec<u8> = rows.values().map(|&b| basis_tag(b)).collect();
+        e.col(&Col::U64(&keys))?;
+        e.col(&Col::U8(&bases))?;
+    }
     Ok(e.w)
 }
 
@@ -664,6 +783,9 @@ fn write_payload<W: Write>(
     e.section(b"FCON", &[Col::V2(&sim.f_contact)])?;
     if let Some(c) = &sim.contact {
         e.section_bytes(b"CONT", &contact_bytes(c)?)?;
+    }
+    if let Some(c) = &sim.cracks {
+        e.section_bytes(b"CRAK", &crack_bytes(c)?)?;
     }
     e.section_bytes(b"END!", &[])
 }
@@ -897,8 +1019,9 @@ fn sections(payload: &[u8]) -> Result<Sections<'_>, String> {
         if &tag == b"END!" {
             break;
         }
-        const KNOWN: [&[u8; 4]; 9] = [
+        const KNOWN: [&[u8; 4]; 10] = [
             b"META", b"PART", b"QUAD", b"QTAB", b"PTAB", b"GATH", b"BODY", b"FCON", b"CONT",
+            b"CRAK",
         ];
         if !KNOWN.contains(&&tag) {
             return Err(format!(
@@ -1051,7 +1174,19 @@ fn restore(
     };
     let n = meta.usize()?;
     let nq = meta.usize()?;
+    let heat_every = meta.u64()?;
+    let heat_pending = meta.f64()?;
+    let driven_constraints = match meta.u32()? {
+        0 => false,
+        1 => true,
+        v => return Err(format!("driven-constraint flag {v} is neither 0 nor 1")),
+    };
     meta.finish()?;
+    if heat_every == 0 || !(heat_pending.is_finite() && heat_pending >= 0.0) {
+        return Err(format!(
+            "conduction every {heat_every} steps with {heat_pending} s pending is not usable"
+        ));
+    }
     if !(dt.is_finite() && dt > 0.0 && time.is_finite()) {
         return Err(format!("time {time} s or step {dt} s is not usable"));
     }
@@ -1228,7 +1363,14 @@ fn restore(
     sim.energies = energies;
     sim.speed_bound = speed_bound;
     sim.f_contact = f_contact;
+    sim.driven_constraints = driven_constraints;
+    sim.heat_every = heat_every;
+    sim.heat_pending = heat_pending;
+    sim.heat = case
+        .heat_conduction_for(&sim.model)
+        .map_err(|e| format!("heat conduction: {e}"))?;
     sim.contact = restore_contact(all, case, n)?;
+    sim.cracks = restore_cracks(all, case, &sim.model)?;
     Ok((sim, progress))
 }
 
@@ -1294,6 +1436,166 @@ fn restore_contact(all: &Sections, case: &Case, n: usize) -> Result<Option<Conta
     let mut c = ContactSystem::new(bodies, slaves, case.contact).map_err(|e| e.to_string())?;
     c.restore_accumulators(acc).map_err(|e| e.to_string())?;
     Ok(Some(c))
+}
+
+/// Most cells of the segment bins one restored crack segment may span: a
+/// real segment spans a few supports, so this only stops a damaged file
+/// from making the binning loop over an absurd range.
+const MAX_SEGMENT_CELLS: Real = 1e4;
+
+fn restore_cracks(all: &Sections, case: &Case, model: &Model) -> Result<Option<CrackGrowth>, String> {
+    let stored = all.iter().any(|(t, _)| t == b"CRAK");
+    if case.fracture.criterion == Criterion::None {
+        return if stored {
+            Err("crack state, but the case has no fracture criterion".into())
+        } else {
+            Ok(None)
+        };
+    }
+    let (n, nq) = (model.particles.len(), model.quad.len());
+    let mut d = section(all, b"CRAK", "CRAK")?;
+    let criterion = match d.u32()? {
+        0 => Criterion::EffectiveStrain,
+        1 => Criterion::Damage,
+        2 => Criterion::None,
+        t => return Err(format!("unknown fracture criterion tag {t}")),
+    };
+    let mut v = [0.0; 6];
+    for x in &mut v {
+        *x = d.f64()?;
+    }
+    let [critical_effective_strain, critical_damage, radius_factor, fan_angle, offset_ratio, nucleation_distance_factor] = v;
+    let params = FractureParameters {
+        criterion,
+        critical_effective_strain,
+        critical_damage,
+        radius_factor,
+        fan_angle,
+        offset_ratio,
+        nucleation_distance_factor,
+    };
+    if params != case.fracture {
+        return Err("the fracture parameters do not match the case".into());
+    }
+    let count = d.usize()?;
+    let mut cracks = Vec::with_capacity(count.min(1024));
+    for k in 0..count {
+        let id = d.usize()?;
+        let tip = match d.u64()? {
+            u64::MAX => None,
+            t if t < n as u64 => Some(t as usize),
+            t => return Err(format!("crack {k}: tip particle {t} of {n}")),
+        };
+        let offset = d.f64()?;
+        let nucleated = (d.f64()?, d.u64()?);
+        let arrested_flag = d.u32()?;
+        let arrested_at = (d.f64()?, d.u64()?);
+        let arrested = match arrested_flag {
+            0 => None,
+            1 => Some(arrested_at),
+            f => return Err(format!("crack {k}: arrest flag {f}")),
+        };
+        let (x0, tag, left, right) = (d.v2s()?, d.u8s()?, d.u32s()?, d.u32s()?);
+        let m = x0.len();
+        if id != k
+            || m < 2
+            || [tag.len(), left.len(), right.len()] != [m; 3]
+            || !(offset.is_finite() && offset >= 0.0)
+            || !nucleated.0.is_finite()
+            || arrested.is_some_and(|a| !a.0.is_finite())
+            || x0.iter().any(|p| !(p.x.is_finite() && p.y.is_finite()))
+        {
+            return Err(format!("crack {k} is inconsistent"));
+        }
+        let vertices = (0..m)
+            .map(|j| match tag[j] {
+                0 => Ok(CrackVertex { x0: x0[j], faces: None }),
+                1 if (left[j] as usize) < n && (right[j] as usize) < n => Ok(CrackVertex {
+                    x0: x0[j],
+                    faces: Some((left[j], right[j])),
+                }),
+                _ => Err(format!("crack {k}: vertex {j} has invalid faces")),
+            })
+            .collect::<Result<Vec<_>, String>>()?;
+        cracks.push(Crack {
+            id,
+            vertices,
+            tip,
+            offset,
+            nucleated,
+            arrested,
+        });
+    }
+    let (time, step, crack, kind) = (d.f64s()?, d.u64s()?, d.usizes()?, d.u8s()?);
+    let (offsets, particles, value) = (d.usizes()?, d.usizes()?, d.f64s()?);
+    let ne = time.len();
+    let events_ok = [step.len(), crack.len(), kind.len(), value.len()] == [ne; 4]
+        && offsets.len() == ne + 1
+        && offsets.first() == Some(&0)
+        && offsets.last() == Some(&particles.len())
+        && offsets.windows(2).all(|w| w[0] <= w[1])
+        && crack.iter().all(|&c| c < cracks.len())
+        && particles.iter().all(|&i| i < n);
+    if !events_ok {
+        return Err("the crack event log is inconsistent".into());
+    }
+    let events = (0..ne)
+        .map(|k| {
+            let kind = match kind[k] {
+                0 => EventKind::Nucleate,
+                1 => EventKind::Propagate,
+                2 => EventKind::Arrest,
+                t => return Err(format!("crack event {k}: unknown kind {t}")),
+            };
+            Ok(CrackEvent {
+                time: time[k],
+                step: step[k],
+                crack: crack[k],
+                kind,
+                particles: particles[offsets[k]..offsets[k + 1]].to_vec(),
+                value: value[k],
+            })
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    let mut reduced = [Default::default(), Default::default()];
+    for (map, (what, rows)) in reduced.iter_mut().zip([("quadrature", nq), ("particle", n)]) {
+        let (keys, bases) = (d.usizes()?, d.u8s()?);
+        if keys.len() != bases.len() || keys.iter().any(|&k| k >= rows) {
+            return Err(format!("the reduced {what} rows are inconsistent"));
+        }
+        *map = keys
+            .into_iter()
+            .zip(bases)
+            .map(|(k, b)| match b {
+                0 => Ok((k, Basis::Bilinear)),
+                1 => Ok((k, Basis::Linear)),
+                2 => Ok((k, Basis::Constant)),
+                t => Err(format!("reduced {what} row {k}: unknown basis tag {t}")),
+            })
+            .collect::<Result<_, String>>()?;
+    }
+    d.finish()?;
+    // The segments are binned in cells of the largest support (as
+    // `CrackGrowth::refresh_segments` does).
+    let cell = model.particles.support.iter().cloned().fold(0.0, Real::max);
+    let cell = if cell > 0.0 && cell.is_finite() { cell } else { 1.0 };
+    for c in &cracks {
+        for (a, b) in c.segments() {
+            let span = (a - b).abs() / cell;
+            if span.iter().any(|&s| s > MAX_SEGMENT_CELLS) {
+                return Err(format!("crack {}: a segment spans more than {MAX_SEGMENT_CELLS} cells", c.id));
+            }
+        }
+    }
+    let [reduced_quadrature_rows, reduced_particle_rows] = reduced;
+    Ok(Some(CrackGrowth::from_state(
+        params,
+        cracks,
+        events,
+        reduced_quadrature_rows,
+        reduced_particle_rows,
+        model,
+    )))
 }
 
 #[cfg(test)]

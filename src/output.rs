@@ -80,36 +80,49 @@ impl OutputWriter {
     }
 
     /// Continue the outputs of a resumed run in `dir`: the series holds the
-    /// snapshots at `snapshot_times` (`particles_00000.vtu`, ...), snapshot
-    /// files after them are removed, and `history.csv` is cut to its first
-    /// `history_bytes` bytes (the rows up to the checkpoint) and continued.
+    /// snapshots at `snapshot_times` (`particles_00000.vtu`, ...; with
+    /// `cracks`, also their part-1 crack files `cracks_00000.vtu`, ...),
+    /// snapshot files after them are removed, `history.csv` is cut to its
+    /// first `history_bytes` bytes (the rows up to the checkpoint) and
+    /// continued, and `cracks.csv` is rewritten with the events of `cracks`
+    /// (those up to the checkpoint; removed if there are none) and continued.
     pub fn resume(
         dir: &Path,
         fields: &[String],
         rigid_names: &[String],
         snapshot_times: &[Real],
         history_bytes: u64,
+        cracks: Option<&crate::fracture::CrackGrowth>,
     ) -> Result<Self, IoError> {
         let cols = history_columns(rigid_names);
         let cols: Vec<&str> = cols.iter().map(|s| s.as_str()).collect();
         let history = HistoryWriter::continue_at(&dir.join("history.csv"), &cols, history_bytes)?;
+        // In the order `snapshot` appends them: by time, then part.
         let entries = snapshot_times
             .iter()
             .enumerate()
-            .map(|(k, &time)| crate::io::PvdEntry { time, file: snapshot_name(k), part: 0 })
+            .flat_map(|(k, &time)| {
+                let particles = crate::io::PvdEntry { time, file: snapshot_name(k), part: 0 };
+                let crack = cracks.map(|_| crate::io::PvdEntry { time, file: crack_snapshot_name(k), part: 1 });
+                std::iter::once(particles).chain(crack)
+            })
             .collect();
         let series = PvdSeries::with_entries(&dir.join("results.pvd"), entries)?;
         let n = snapshot_times.len();
         if let Ok(listing) = std::fs::read_dir(dir) {
             for e in listing.flatten() {
                 let name = e.file_name().to_string_lossy().to_string();
-                let index = name.strip_prefix("particles_").and_then(|r| r.strip_suffix(".vtu")).and_then(|k| k.parse::<usize>().ok());
+                let index = ["particles_", "cracks_"]
+                    .iter()
+                    .find_map(|prefix| name.strip_prefix(prefix))
+                    .and_then(|r| r.strip_suffix(".vtu"))
+                    .and_then(|k| k.parse::<usize>().ok());
                 if index.is_some_and(|k| k >= n) {
                     std::fs::remove_file(e.path()).map_err(|source| IoError::Write { path: e.path(), source })?;
                 }
             }
         }
-        Ok(OutputWriter {
+        let mut out = OutputWriter {
             dir: dir.to_path_buf(),
             fields: fields.to_vec(),
             series,
@@ -117,7 +130,16 @@ impl OutputWriter {
             snapshots: n,
             crack_log: None,
             crack_events_written: 0,
-        })
+        };
+        let log = dir.join("cracks.csv");
+        match cracks {
+            Some(c) if !c.events.is_empty() => out.write_crack_events(c)?,
+            _ if log.exists() => {
+                std::fs::remove_file(&log).map_err(|source| IoError::Write { path: log.clone(), source })?
+            }
+            _ => {}
+        }
+        Ok(out)
     }
 
     /// Simulated times of the snapshots written so far, s.
@@ -148,7 +170,7 @@ impl OutputWriter {
         write_vtu(&path, &particle_piece(&sim.model, &self.fields))?;
         self.series.append(sim.time, &name, 0)?;
         if let Some(cracks) = &sim.cracks {
-            let crack_name = format!("cracks_{:05}.vtu", self.snapshots);
+            let crack_name = crack_snapshot_name(self.snapshots);
             write_vtu(&self.dir.join(&crack_name), &crack_piece(&sim.model, cracks))?;
             self.series.append(sim.time, &crack_name, 1)?;
         }
@@ -193,10 +215,15 @@ impl OutputWriter {
     /// Append the crack events not yet written to `cracks.csv` (created at
     /// the first event, with the header [`CRACK_COLUMNS`]).
     pub fn crack_events(&mut self, sim: &Simulation) -> Result<(), IoError> {
+        match &sim.cracks {
+            Some(cracks) => self.write_crack_events(cracks),
+            None => Ok(()),
+        }
+    }
+
+    /// Append the events of `cracks` not yet written to `cracks.csv`.
+    fn write_crack_events(&mut self, cracks: &crate::fracture::CrackGrowth) -> Result<(), IoError> {
         use std::io::Write;
-        let Some(cracks) = &sim.cracks else {
-            return Ok(());
-        };
         if cracks.events.len() == self.crack_events_written {
             return Ok(());
         }
@@ -243,6 +270,11 @@ pub fn crack_piece(model: &Model, cracks: &crate::fracture::CrackGrowth) -> VtuP
 /// File name of snapshot `k`.
 pub fn snapshot_name(k: usize) -> String {
     format!("particles_{k:05}.vtu")
+}
+
+/// File name of the cracks of snapshot `k` (part 1 of the series).
+pub fn crack_snapshot_name(k: usize) -> String {
+    format!("cracks_{k:05}.vtu")
 }
 
 fn v3(v: &Vec2) -> [f64; 3] {

@@ -10,7 +10,6 @@ use crate::memory::{Footprint, MemoryError};
 use crate::model::{Model, ModelError};
 use crate::output::OutputWriter;
 use crate::step::{Simulation, SolverError};
-use crate::thermal::HeatConduction;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -169,10 +168,8 @@ pub fn preflight(case: &Case) -> Result<Footprint, RunError> {
 /// for it ([`Case::heat_conduction`]).
 pub fn build_simulation(case: &Case) -> Result<Simulation, RunError> {
     let mut sim = build_simulation_without_cracks(case)?;
-    if case.heat_conduction() {
-        sim.heat = Some(HeatConduction::new(&sim.model, case.heat.safety_factor)?);
-        sim.heat_every = case.heat.every;
-    }
+    sim.heat = case.heat_conduction_for(&sim.model)?;
+    sim.heat_every = case.heat.every;
     if case.fracture.criterion != crate::fracture::Criterion::None {
         sim.cracks = Some(crate::fracture::CrackGrowth::new(case.fracture));
     }
@@ -275,7 +272,14 @@ pub fn resume(cfg: &RunConfig, progress: &mut dyn FnMut(Progress)) -> Result<Run
         ));
     }
     let rigid_names: Vec<String> = case.rigid_bodies.iter().map(|r| r.name.clone()).collect();
-    let out = OutputWriter::resume(&cfg.out_dir, &case.output.fields, &rigid_names, &saved.snapshot_times, saved.history_bytes)?;
+    let out = OutputWriter::resume(
+        &cfg.out_dir,
+        &case.output.fields,
+        &rigid_names,
+        &saved.snapshot_times,
+        saved.history_bytes,
+        sim.cracks.as_ref(),
+    )?;
     append_resume_record(cfg, &path, sim.step)?;
     progress(Progress::Resumed { sim: &sim, checkpoint: &path, warnings: &warnings });
     let schedule = Schedule { next_snapshot: saved.next_snapshot, next_checkpoint: saved.next_checkpoint, max_drift: saved.max_drift };

@@ -14,6 +14,7 @@ use std::sync::Arc;
 
 const STRIKE: &str = include_str!("../cases/elastic-strike.toml");
 const BORVIK: &str = include_str!("../cases/borvik-1-nofracture.toml");
+const BORVIK_FRACTURE: &str = include_str!("../cases/borvik-1-plane-strain.toml");
 
 fn scratch(name: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("checkpoint-{name}"));
@@ -164,8 +165,8 @@ fn assert_same_outputs(reference: &Path, resumed: &Path) {
 
 /// Kill (no checkpoint at the kill) after a periodic checkpoint, resume:
 /// the final state and every output file equal the uninterrupted run's.
-/// Returns the state the run was resumed from.
-fn kill_and_resume(name: &str, case: &Case, stop_at: u64) -> Simulation {
+/// Returns the state the run was resumed from and the final state.
+fn kill_and_resume(name: &str, case: &Case, stop_at: u64) -> (Simulation, Simulation) {
     let reference = scratch(&format!("{name}-reference"));
     let full = run_through(case, &reference);
 
@@ -185,6 +186,7 @@ fn kill_and_resume(name: &str, case: &Case, stop_at: u64) -> Simulation {
         "checkpoint at step {from_step}, stop at {stop_at}"
     );
     std::fs::write(dir.join("particles_00999.vtu"), b"stale").unwrap();
+    std::fs::write(dir.join("cracks_00999.vtu"), b"stale").unwrap();
     let rows_before = std::fs::read_to_string(dir.join("history.csv"))
         .unwrap()
         .lines()
@@ -199,6 +201,7 @@ fn kill_and_resume(name: &str, case: &Case, stop_at: u64) -> Simulation {
         !dir.join("particles_00999.vtu").exists(),
         "snapshots after the checkpoint are removed"
     );
+    assert!(!dir.join("cracks_00999.vtu").exists());
     let history = std::fs::read_to_string(dir.join("history.csv")).unwrap();
     assert!(history.lines().count() > rows_before, "history continued");
     let info = std::fs::read_to_string(dir.join("run_info.toml")).unwrap();
@@ -207,7 +210,7 @@ fn kill_and_resume(name: &str, case: &Case, stop_at: u64) -> Simulation {
         info["resumed"].as_array().unwrap()[0]["step"].as_integer(),
         Some(from_step as i64)
     );
-    resumed_from
+    (resumed_from, resumed)
 }
 
 #[test]
@@ -243,7 +246,7 @@ fn resumed_contact_run_is_bit_identical_to_an_uninterrupted_one() {
             "checkpoint.interval=1.5e-6",
         ],
     );
-    let from = kill_and_resume("contact", &case, 20);
+    let (from, _) = kill_and_resume("contact", &case, 20);
     // The contact must be active across the checkpoint for the test to mean anything.
     let c = from.contact.as_ref().unwrap();
     assert!(
@@ -258,6 +261,130 @@ fn resumed_contact_run_is_bit_identical_to_an_uninterrupted_one() {
         (0..c.slaves.len()).any(|k| c.slaves.pairing(k).is_some()),
         "slaves are paired"
     );
+}
+
+/// Crack growth across the checkpoint: a crack nucleated before it grows
+/// after it; the crack state, the crack files of the series and
+/// `cracks.csv` continue exactly (the plane-strain Borvik case on a narrow,
+/// thin plate, with a low critical strain so that cracks start early).
+#[test]
+fn resumed_fracture_run_is_bit_identical_to_an_uninterrupted_one() {
+    let case = case(BORVIK_FRACTURE, FRACTURE_SETS);
+    let (from, end) = kill_and_resume("fracture", &case, FRACTURE_STOP);
+    assert!(
+        case.heat_conduction(),
+        "conduction is on across the checkpoint"
+    );
+    assert!(from.heat_pending > 0.0, "heat is pending at the checkpoint");
+    let at = from.cracks.as_ref().expect("fracture is on");
+    let final_events = &end.cracks.as_ref().unwrap().events;
+    assert!(
+        !at.cracks.is_empty(),
+        "a crack nucleated before the checkpoint"
+    );
+    assert!(
+        final_events.len() > at.events.len()
+            && final_events[at.events.len()..]
+                .iter()
+                .any(|e| e.crack < at.cracks.len()),
+        "a crack of the checkpoint grew after it"
+    );
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("checkpoint-fracture-resumed");
+    let log = std::fs::read_to_string(dir.join("cracks.csv")).unwrap();
+    assert_eq!(
+        log.lines().count(),
+        1 + final_events.len(),
+        "one row per event"
+    );
+    let pvd = std::fs::read_to_string(dir.join("results.pvd")).unwrap();
+    assert_eq!(
+        pvd.matches("part=\"1\"").count(),
+        pvd.matches("part=\"0\"").count(),
+        "every snapshot has its crack file"
+    );
+}
+
+/// Overrides of the fracture resume test; the checkpoint it resumes from is
+/// the periodic one at `checkpoint.interval`, the (discarded) stop at
+/// [`FRACTURE_STOP`].
+const FRACTURE_SETS: &[&str] = &[
+    "bodies.plate.rectangle.layers=6",
+    "bodies.plate.rectangle.x_min=-0.03",
+    "bodies.plate.rectangle.x_max=0.03",
+    "bodies.plate.rectangle.fine_half_width=0.015",
+    "bodies.plate.supports.0.region.x_min=-0.03",
+    "bodies.plate.supports.0.region.x_max=-0.028",
+    "bodies.plate.supports.1.region.x_min=0.028",
+    "bodies.plate.supports.1.region.x_max=0.03",
+    "fracture.critical_effective_strain=0.1",
+    "heat.every=4",
+    "time.end=8e-6",
+    "output.interval=1e-6",
+    "output.history_every=5",
+    "checkpoint.interval=4e-6",
+];
+const FRACTURE_STOP: u64 = 30;
+
+/// The crack log round-trips bit for bit, NaN payloads and −0.0 included.
+#[test]
+fn crack_state_round_trips_bit_for_bit() {
+    let case = case(BORVIK_FRACTURE, FRACTURE_SETS);
+    let dir = scratch("crack-round-trip");
+    let path = run_until(&case, &dir, 2);
+    let mut restored = checkpoint::read(&path).unwrap();
+    let cracks = restored.sim.cracks.as_mut().expect("fracture is on");
+    assert!(cracks.cracks.is_empty(), "no crack yet at step 2");
+    let odd = [
+        f64::from_bits(0x7ff8_dead_beef_0001),
+        -0.0,
+        f64::NEG_INFINITY,
+    ];
+    for (k, value) in odd.into_iter().enumerate() {
+        cracks.events.push(plugsim::fracture::CrackEvent {
+            time: -0.0,
+            step: k as u64,
+            crack: 0,
+            kind: plugsim::fracture::EventKind::Nucleate,
+            particles: vec![k, 2 * k],
+            value,
+        });
+    }
+    // Events must name an existing crack.
+    cracks.cracks.push(plugsim::fracture::Crack {
+        id: 0,
+        vertices: vec![
+            plugsim::fracture::CrackVertex {
+                x0: restored.sim.model.particles.x0[0],
+                faces: None,
+            },
+            plugsim::fracture::CrackVertex {
+                x0: restored.sim.model.particles.x0[1],
+                faces: Some((0, 1)),
+            },
+        ],
+        tip: Some(1),
+        offset: 1e-6,
+        nucleated: (-0.0, 1),
+        arrested: Some((2e-9, 2)),
+    });
+    let again = dir.join("odd.ckpt");
+    checkpoint::write(&again, &restored.sim, &restored.case, &restored.progress).unwrap();
+    let back = checkpoint::read(&again).unwrap();
+    let bytes = |s: &Simulation| checkpoint::state_bytes(s, &restored.case, &restored.progress);
+    assert!(
+        bytes(&back.sim) == bytes(&restored.sim),
+        "state bytes differ after a round trip"
+    );
+    let bits = |s: &Simulation| {
+        s.cracks
+            .as_ref()
+            .unwrap()
+            .events
+            .iter()
+            .map(|e| (e.time.to_bits(), e.value.to_bits()))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(bits(&back.sim), bits(&restored.sim));
 }
 
 #[test]
@@ -303,6 +430,29 @@ fn checkpoint_of_another_format_version_is_refused_naming_both() {
             "{e}"
         );
     }
+}
+
+/// Format 1 (written before crack growth and heat conduction were carried)
+/// is refused, naming both versions, rather than resumed without them.
+#[test]
+fn version_1_checkpoint_is_refused_naming_both_versions() {
+    assert_eq!(FORMAT_VERSION, 2);
+    let case = case(STRIKE, &["time.end=1e-6"]);
+    let dir = scratch("version-1");
+    let path = run_until(&case, &dir, 2);
+    corrupt(&path, 8, &1u32.to_le_bytes());
+    let e = checkpoint::read(&path).unwrap_err().to_string();
+    assert!(
+        e.contains("format version 1 ") && e.contains("reads format version 2"),
+        "{e}"
+    );
+    let e = resume(&config(&dir, None), &mut |_| {})
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("format version 1 ") && e.contains("format version 2"),
+        "{e}"
+    );
 }
 
 #[test]

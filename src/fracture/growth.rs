@@ -195,6 +195,31 @@ impl CrackGrowth {
         }
     }
 
+    /// The stage in a state read back from a checkpoint: the persistent
+    /// state as stored, the opaque segments rebuilt from the cracks (as
+    /// after a split) and the circle-search grid left to be rebuilt at its
+    /// next use. `model` is the restored model the cracks belong to.
+    pub fn from_state(
+        params: FractureParameters,
+        cracks: Vec<Crack>,
+        events: Vec<CrackEvent>,
+        reduced_quadrature_rows: BTreeMap<usize, Basis>,
+        reduced_particle_rows: BTreeMap<usize, Basis>,
+        model: &Model,
+    ) -> Self {
+        let mut growth = CrackGrowth {
+            params,
+            cracks,
+            events,
+            segments: CrackSegments::default(),
+            grid: None,
+            reduced_quadrature_rows,
+            reduced_particle_rows,
+        };
+        growth.refresh_segments(model);
+        growth
+    }
+
     /// The opaque segments of all cracks.
     pub fn segments(&self) -> &CrackSegments {
         &self.segments
@@ -697,7 +722,9 @@ impl CrackGrowth {
         Ok((l, r))
     }
 
-    fn refresh_segments(&mut self, model: &Model) {
+    /// Rebuild the binned opaque segments from the cracks, in cells of the
+    /// largest support of `model`.
+    pub fn refresh_segments(&mut self, model: &Model) {
         let all: Vec<(Vec2, Vec2)> = self.cracks.iter().flat_map(|c| c.segments()).collect();
         let cell = model.particles.support.iter().cloned().fold(0.0, Real::max);
         self.segments = CrackSegments::new(all, cell);

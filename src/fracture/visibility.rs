@@ -23,12 +23,26 @@ use crate::shape::Visibility;
 use std::collections::HashMap;
 
 /// Opaque crack segments (extended), binned for the sight-line test.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Default)]
 pub struct CrackSegments {
     /// Extended segment end points `(a, b)`, m.
     pub segments: Vec<(Vec2, Vec2)>,
     cell: Real,
     bins: HashMap<(i64, i64), Vec<u32>>,
+}
+
+/// The bins in cell order: a `HashMap` prints in an order that differs
+/// between equal maps, and tests compare whole simulations by their
+/// `Debug` text.
+impl std::fmt::Debug for CrackSegments {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let bins: std::collections::BTreeMap<_, _> = self.bins.iter().collect();
+        f.debug_struct("CrackSegments")
+            .field("segments", &self.segments)
+            .field("cell", &self.cell)
+            .field("bins", &bins)
+            .finish()
+    }
 }
 
 impl CrackSegments {
