@@ -45,7 +45,11 @@ pub fn shape_build(case: &Case, threads: usize) -> Result<Figure, RunError> {
     })
     .map_err(|source| crate::model::ModelError::Shape { body: "bench".into(), source })?;
     let s = t.elapsed().as_secs_f64();
-    Ok(fig(format!("shape-function build, {threads} thread(s), {} entries", table.nnz()), m.quad.len() as Real / s, "rows/s"))
+    Ok(fig(
+        format!("shape-function build, {threads} thread(s), {} entries", table.nnz()),
+        m.quad.len() as Real / s,
+        "rows/s",
+    ))
 }
 
 /// Single-point material updates per second (one thread), in the elastic
@@ -70,7 +74,11 @@ pub fn material_kernel(material: &Material, n: usize) -> Vec<Figure> {
             s = if label == "elastic" { PointState { tau: s.tau, ..next } } else { next };
         }
         std::hint::black_box(acc);
-        out.push(fig(format!("material update ({label}), 1 thread"), n as Real / t.elapsed().as_secs_f64(), "updates/s"));
+        out.push(fig(
+            format!("material update ({label}), 1 thread"),
+            n as Real / t.elapsed().as_secs_f64(),
+            "updates/s",
+        ));
     }
     out
 }
@@ -127,7 +135,11 @@ pub fn force_assembly(case: &Case, threads: usize, n: usize) -> Result<Vec<Figur
         std::hint::black_box(&f);
         Ok(vec![
             fig(format!("force assembly: gather (production), {threads} thread(s)"), gather_rate, "assemblies/s"),
-            fig(format!("force assembly: per-thread scatter (alternative), {threads} thread(s)"), scatter_rate, "assemblies/s"),
+            fig(
+                format!("force assembly: per-thread scatter (alternative), {threads} thread(s)"),
+                scatter_rate,
+                "assemblies/s",
+            ),
         ])
     })
 }

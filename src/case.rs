@@ -370,7 +370,8 @@ impl Case {
     /// Read, override, parse and validate a case file.
     pub fn load(path: &Path, overrides: &[String]) -> Result<Case, CaseError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| CaseError::Read { file: file.clone(), message: e.to_string() })?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| CaseError::Read { file: file.clone(), message: e.to_string() })?;
         Case::from_str_with(&text, &file, overrides)
     }
 
@@ -379,11 +380,16 @@ impl Case {
         let mut table: toml::Table = toml::from_str(text)
             .map_err(|e| CaseError::Parse { file: file.to_string(), message: toml_message(&e, Some(text)) })?;
         for o in overrides {
-            apply_override(&mut table, o).map_err(|(key, message)| CaseError::Override { file: file.to_string(), key, message })?;
+            apply_override(&mut table, o).map_err(|(key, message)| CaseError::Override {
+                file: file.to_string(),
+                key,
+                message,
+            })?;
         }
-        let case: Case = table
-            .try_into()
-            .map_err(|e: toml::de::Error| CaseError::Parse { file: file.to_string(), message: toml_message(&e, None) })?;
+        let case: Case = table.try_into().map_err(|e: toml::de::Error| CaseError::Parse {
+            file: file.to_string(),
+            message: toml_message(&e, None),
+        })?;
         let problems = case.validate();
         if problems.is_empty() {
             Ok(case)
@@ -472,7 +478,10 @@ impl Case {
                     if o.len() < 3 {
                         add(format!("{k}.outline"), format!("a polygon needs at least 3 vertices, got {}", o.len()));
                     } else if signed_area(o) <= 0.0 {
-                        add(format!("{k}.outline"), "must be a simple polygon listed counter-clockwise (positive area)".into());
+                        add(
+                            format!("{k}.outline"),
+                            "must be a simple polygon listed counter-clockwise (positive area)".into(),
+                        );
                     }
                 }
                 (None, Some(rect)) => {
@@ -498,7 +507,10 @@ impl Case {
             add("contact.friction_coefficient".into(), format!("must be >= 0, got {mu}"));
         }
         if !(self.contact.inverse_distance_floor.is_finite() && self.contact.inverse_distance_floor > 0.0) {
-            add("contact.inverse_distance_floor".into(), format!("must be > 0, got {}", self.contact.inverse_distance_floor));
+            add(
+                "contact.inverse_distance_floor".into(),
+                format!("must be > 0, got {}", self.contact.inverse_distance_floor),
+            );
         }
         if self.contact.max_iterations == 0 {
             add("contact.max_iterations".into(), "must be at least 1".into());
@@ -544,7 +556,10 @@ impl Case {
             if i > 0.0 && self.time.end / i > MAX_SNAPSHOTS {
                 add(
                     "output.interval".into(),
-                    format!("{i} s would write {:.3e} snapshots up to time.end (at most {MAX_SNAPSHOTS})", self.time.end / i),
+                    format!(
+                        "{i} s would write {:.3e} snapshots up to time.end (at most {MAX_SNAPSHOTS})",
+                        self.time.end / i
+                    ),
                 );
             }
         }
@@ -560,7 +575,10 @@ impl Case {
         }
         for (j, f) in self.output.fields.iter().enumerate() {
             if !OUTPUT_FIELDS.contains(&f.as_str()) {
-                add(format!("output.fields[{j}]"), format!("unknown field '{f}' (known: {})", OUTPUT_FIELDS.join(", ")));
+                add(
+                    format!("output.fields[{j}]"),
+                    format!("unknown field '{f}' (known: {})", OUTPUT_FIELDS.join(", ")),
+                );
             }
         }
         p
@@ -731,7 +749,10 @@ fn validate_grid(add: &mut impl FnMut(String, String), key: &str, g: &RectangleG
         add(format!("{key}.x_max"), format!("must exceed x_min (zero or negative length): {} <= {}", g.x_max, g.x_min));
     }
     if g.y_max.partial_cmp(&g.y_min) != Some(std::cmp::Ordering::Greater) {
-        add(format!("{key}.y_max"), format!("must exceed y_min (zero or negative thickness): {} <= {}", g.y_max, g.y_min));
+        add(
+            format!("{key}.y_max"),
+            format!("must exceed y_min (zero or negative thickness): {} <= {}", g.y_max, g.y_min),
+        );
     }
     if mode == GeometryMode::Axisymmetric && g.x_min < 0.0 {
         add(format!("{key}.x_min"), format!("is a radius in axisymmetry and must be >= 0, got {}", g.x_min));

@@ -71,9 +71,7 @@
 use crate::case::{Case, MaterialSpec};
 use crate::contact::{ContactAccumulators, ContactSystem, MasterFeature, Pairing, SlaveSet};
 use crate::fracture::rows::Basis;
-use crate::fracture::{
-    Crack, CrackEvent, CrackGrowth, CrackVertex, Criterion, EventKind, FractureParameters,
-};
+use crate::fracture::{Crack, CrackEvent, CrackGrowth, CrackVertex, Criterion, EventKind, FractureParameters};
 use crate::material::Material;
 use crate::math::{Real, Tensor3, Vec2};
 use crate::model::{BodyInfo, Gather, Model};
@@ -145,12 +143,7 @@ pub enum CheckpointError {
          reads format version {supported} only; resume it with the plugsim that wrote it, or rerun the case",
         path.display(), this_writer()
     )]
-    Version {
-        path: PathBuf,
-        found: u32,
-        supported: u32,
-        writer: String,
-    },
+    Version { path: PathBuf, found: u32, supported: u32, writer: String },
     #[error("checkpoint {} is damaged: {reason}", path.display())]
     Damaged { path: PathBuf, reason: String },
     #[error("checkpoint {}: its case no longer reads: {message}", path.display())]
@@ -165,11 +158,7 @@ pub enum CheckpointError {
 
 /// `plugsim VERSION (COMMIT)` of this build, written into every header.
 pub fn this_writer() -> String {
-    format!(
-        "plugsim {} ({})",
-        env!("CARGO_PKG_VERSION"),
-        option_env!("PLUGSIM_COMMIT").unwrap_or("unknown")
-    )
+    format!("plugsim {} ({})", env!("CARGO_PKG_VERSION"), option_env!("PLUGSIM_COMMIT").unwrap_or("unknown"))
 }
 
 /// The checkpoint directory of a run's output directory.
@@ -192,11 +181,7 @@ pub fn list(dir: &Path) -> Vec<(u64, PathBuf)> {
         .filter_map(|e| {
             let path = e.ok()?.path();
             let name = path.file_name()?.to_str()?;
-            let step = name
-                .strip_prefix("checkpoint-")?
-                .strip_suffix(&format!(".{EXTENSION}"))?
-                .parse()
-                .ok()?;
+            let step = name.strip_prefix("checkpoint-")?.strip_suffix(&format!(".{EXTENSION}"))?.parse().ok()?;
             Some((step, path))
         })
         .collect();
@@ -210,10 +195,7 @@ pub fn rotate(dir: &Path, keep: usize) -> Result<(), CheckpointError> {
     let all = list(dir);
     let excess = all.len().saturating_sub(keep.max(1));
     for (_, path) in &all[..excess] {
-        std::fs::remove_file(path).map_err(|source| CheckpointError::Io {
-            path: path.clone(),
-            source,
-        })?;
+        std::fs::remove_file(path).map_err(|source| CheckpointError::Io { path: path.clone(), source })?;
     }
     remove_temporaries(dir);
     Ok(())
@@ -224,10 +206,7 @@ pub fn rotate(dir: &Path, keep: usize) -> Result<(), CheckpointError> {
 /// for `plugsim resume` to find.
 pub fn remove_all(dir: &Path) -> Result<(), CheckpointError> {
     for (_, path) in list(dir) {
-        std::fs::remove_file(&path).map_err(|source| CheckpointError::Io {
-            path: path.clone(),
-            source,
-        })?;
+        std::fs::remove_file(&path).map_err(|source| CheckpointError::Io { path: path.clone(), source })?;
     }
     remove_temporaries(dir);
     Ok(())
@@ -256,9 +235,7 @@ pub fn read_latest(out_dir: &Path) -> Result<(Restored, Vec<String>), Checkpoint
     for (_, path) in all.iter().rev() {
         match read(path) {
             Ok(r) => return Ok((r, warnings)),
-            Err(e @ (CheckpointError::Version { .. } | CheckpointError::Case { .. })) => {
-                return Err(e)
-            }
+            Err(e @ (CheckpointError::Version { .. } | CheckpointError::Case { .. })) => return Err(e),
             Err(e) => {
                 warnings.push(format!("skipped {e}"));
                 first_error.get_or_insert(e);
@@ -409,18 +386,8 @@ fn offsets_u64(o: &[usize]) -> Vec<u64> {
 }
 
 fn table_cols<'a>(t: &'a ShapeTable, offsets: &'a [u64]) -> [Col<'a>; 4] {
-    let ShapeTable {
-        offsets: _,
-        index,
-        value,
-        grad,
-    } = t;
-    [
-        Col::U64(offsets),
-        Col::U32(index),
-        Col::F64(value),
-        Col::V2(grad),
-    ]
+    let ShapeTable { offsets: _, index, value, grad } = t;
+    [Col::U64(offsets), Col::U32(index), Col::F64(value), Col::V2(grad)]
 }
 
 /// The case with its built-in materials written out, so that the stored
@@ -453,42 +420,18 @@ fn material_spec(m: &Material) -> MaterialSpec {
 }
 
 /// The `META` section: case text, clocks, energies, run progress.
-fn meta_bytes(
-    sim: &Simulation,
-    case_text: &str,
-    progress: &RunProgress,
-) -> std::io::Result<Vec<u8>> {
+fn meta_bytes(sim: &Simulation, case_text: &str, progress: &RunProgress) -> std::io::Result<Vec<u8>> {
     let mut e = Enc { w: Vec::new() };
     e.str(case_text)?;
     e.f64(sim.time)?;
     e.u64(sim.step)?;
     e.f64(sim.dt)?;
     e.f64(sim.speed_bound)?;
-    let Energies {
-        kinetic,
-        internal,
-        rigid_kinetic,
-        contact_work,
-        rigid_work,
-        initial_kinetic,
-    } = sim.energies;
-    for v in [
-        kinetic,
-        internal,
-        rigid_kinetic,
-        contact_work,
-        rigid_work,
-        initial_kinetic,
-    ] {
+    let Energies { kinetic, internal, rigid_kinetic, contact_work, rigid_work, initial_kinetic } = sim.energies;
+    for v in [kinetic, internal, rigid_kinetic, contact_work, rigid_work, initial_kinetic] {
         e.f64(v)?;
     }
-    let RunProgress {
-        snapshot_times,
-        history_bytes,
-        next_snapshot,
-        next_checkpoint,
-        max_drift,
-    } = progress;
+    let RunProgress { snapshot_times, history_bytes, next_snapshot, next_checkpoint, max_drift } = progress;
     e.col(&Col::F64(snapshot_times))?;
     e.u64(*history_bytes)?;
     e.f64(*next_snapshot)?;
@@ -506,22 +449,9 @@ fn body_bytes(bodies: &[BodyInfo]) -> std::io::Result<Vec<u8>> {
     let mut e = Enc { w: Vec::new() };
     e.u64(bodies.len() as u64)?;
     for b in bodies {
-        let BodyInfo {
-            name,
-            particles,
-            quad_points,
-            columns,
-            rows,
-        } = b;
+        let BodyInfo { name, particles, quad_points, columns, rows } = b;
         e.str(name)?;
-        for v in [
-            particles.start,
-            particles.end,
-            quad_points.start,
-            quad_points.end,
-            *columns,
-            *rows,
-        ] {
+        for v in [particles.start, particles.end, quad_points.start, quad_points.end, *columns, *rows] {
             e.u64(v as u64)?;
         }
     }
@@ -540,14 +470,8 @@ fn contact_bytes(c: &ContactSystem) -> std::io::Result<Vec<u8>> {
     for k in 0..slaves.len() {
         let (t, b, f) = match c.slaves.pairing(k) {
             None => (0u8, 0u32, 0u32),
-            Some(Pairing {
-                body,
-                feature: MasterFeature::Segment(s),
-            }) => (1, body, s),
-            Some(Pairing {
-                body,
-                feature: MasterFeature::Vertex(v),
-            }) => (2, body, v),
+            Some(Pairing { body, feature: MasterFeature::Segment(s) }) => (1, body, s),
+            Some(Pairing { body, feature: MasterFeature::Vertex(v) }) => (2, body, v),
         };
         kind.push(t);
         body.push(b);
@@ -557,21 +481,11 @@ fn contact_bytes(c: &ContactSystem) -> std::io::Result<Vec<u8>> {
     e.col(&Col::U8(&kind))?;
     e.col(&Col::U32(&body))?;
     e.col(&Col::U32(&feature))?;
-    let ContactAccumulators {
-        work_on_particles,
-        work_on_body,
-        reaction,
-        active_per_body,
-    } = c.accumulators();
+    let ContactAccumulators { work_on_particles, work_on_body, reaction, active_per_body } = c.accumulators();
     e.col(&Col::F64(&work_on_particles))?;
     e.col(&Col::F64(&work_on_body))?;
     e.col(&Col::V2(&reaction))?;
-    e.col(&Col::U64(
-        &active_per_body
-            .iter()
-            .map(|&a| a as u64)
-            .collect::<Vec<_>>(),
-    ))?;
+    e.col(&Col::U64(&active_per_body.iter().map(|&a| a as u64).collect::<Vec<_>>()))?;
     Ok(e.w)
 }
 
@@ -606,26 +520,14 @@ fn crack_bytes(c: &CrackGrowth) -> std::io::Result<Vec<u8>> {
         Criterion::Damage => 1,
         Criterion::None => 2,
     })?;
-    for v in [
-        critical_effective_strain,
-        critical_damage,
-        radius_factor,
-        fan_angle,
-        offset_ratio,
-        nucleation_distance_factor,
-    ] {
+    for v in
+        [critical_effective_strain, critical_damage, radius_factor, fan_angle, offset_ratio, nucleation_distance_factor]
+    {
         e.f64(v)?;
     }
     e.u64(c.cracks.len() as u64)?;
     for k in &c.cracks {
-        let Crack {
-            id,
-            vertices,
-            tip,
-            offset,
-            nucleated,
-            arrested,
-        } = k;
+        let Crack { id, vertices, tip, offset, nucleated, arrested } = k;
         e.u64(*id as u64)?;
         e.u64(tip.map_or(u64::MAX, |t| t as u64))?;
         e.f64(*offset)?;
@@ -690,22 +592,8 @@ fn write_payload<W: Write>(
     e.section_bytes(b"META", &meta_bytes(sim, case_text, progress)?)?;
     // Exhaustive destructuring: a field added to a store fails to compile
     // here until the checkpoint carries it (and FORMAT_VERSION is bumped).
-    let Particles {
-        x0,
-        u,
-        v,
-        a,
-        f_int,
-        f_ext,
-        mass,
-        volume,
-        spacing,
-        support,
-        temperature,
-        body,
-        flags,
-        face_side,
-    } = &m.particles;
+    let Particles { x0, u, v, a, f_int, f_ext, mass, volume, spacing, support, temperature, body, flags, face_side } =
+        &m.particles;
     let flag_bytes: Vec<u8> = flags.iter().map(|f| f.0).collect();
     // Crack-face sides: a tag (0 none, 1 left, 2 right) and the geometry.
     let side_tag: Vec<u8> = face_side.iter().map(|s| s.map_or(0, |f| if f.left { 1 } else { 2 })).collect();
@@ -737,18 +625,7 @@ fn write_payload<W: Write>(
             Col::F64(&side_reach),
         ],
     )?;
-    let QuadraturePoints {
-        x0,
-        weight,
-        body,
-        f,
-        tau,
-        eps_p,
-        eps_p_rate,
-        temperature,
-        damage,
-        pw,
-    } = &m.quad;
+    let QuadraturePoints { x0, weight, body, f, tau, eps_p, eps_p_rate, temperature, damage, pw } = &m.quad;
     e.section(
         b"QUAD",
         &[
@@ -770,13 +647,7 @@ fn write_payload<W: Write>(
     e.section(b"PTAB", &table_cols(&m.particle_shape, &po))?;
     // `value` and `grad` are copies of the quadrature table's entries in
     // gather order: restored from the table on reading.
-    let Gather {
-        offsets,
-        entry,
-        point,
-        value: _,
-        grad: _,
-    } = &m.gather;
+    let Gather { offsets, entry, point, value: _, grad: _ } = &m.gather;
     let go = offsets_u64(offsets);
     e.section(b"GATH", &[Col::U64(&go), Col::U32(entry), Col::U32(point)])?;
     e.section_bytes(b"BODY", &body_bytes(&m.bodies)?)?;
@@ -803,22 +674,10 @@ pub fn state_bytes(sim: &Simulation, case: &Case, progress: &RunProgress) -> Vec
 /// Write a checkpoint of `sim` (a run of `case` with outputs at `progress`)
 /// to `path`, atomically: temporary sibling, `fsync`, rename, directory
 /// `fsync`. Returns the file size in bytes.
-pub fn write(
-    path: &Path,
-    sim: &Simulation,
-    case: &Case,
-    progress: &RunProgress,
-) -> Result<u64, CheckpointError> {
-    let io_err = |source| CheckpointError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let case_text = toml::to_string_pretty(&self_contained(case)).map_err(|e| {
-        io_err(std::io::Error::new(
-            std::io::ErrorKind::InvalidData,
-            e.to_string(),
-        ))
-    })?;
+pub fn write(path: &Path, sim: &Simulation, case: &Case, progress: &RunProgress) -> Result<u64, CheckpointError> {
+    let io_err = |source| CheckpointError::Io { path: path.to_path_buf(), source };
+    let case_text = toml::to_string_pretty(&self_contained(case))
+        .map_err(|e| io_err(std::io::Error::new(std::io::ErrorKind::InvalidData, e.to_string())))?;
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).map_err(io_err)?;
     }
@@ -835,21 +694,10 @@ pub fn write(
         head.u64(0)?;
         head.u32(0)?;
         let mut body = Enc {
-            w: BufWriter::with_capacity(
-                1 << 20,
-                Checksummed {
-                    inner: file,
-                    hasher: crc32fast::Hasher::new(),
-                    len: 0,
-                },
-            ),
+            w: BufWriter::with_capacity(1 << 20, Checksummed { inner: file, hasher: crc32fast::Hasher::new(), len: 0 }),
         };
         write_payload(&mut body, sim, &case_text, progress)?;
-        let Checksummed {
-            inner: mut file,
-            hasher,
-            len,
-        } = body.w.into_inner().map_err(|e| e.into_error())?;
+        let Checksummed { inner: mut file, hasher, len } = body.w.into_inner().map_err(|e| e.into_error())?;
         file.seek(SeekFrom::Start(len_at))?;
         file.write_all(&len.to_le_bytes())?;
         file.write_all(&hasher.finalize().to_le_bytes())?;
@@ -869,11 +717,7 @@ pub fn write(
 fn sync_directory(path: &Path) {
     #[cfg(unix)]
     if let Some(dir) = path.parent() {
-        let dir = if dir.as_os_str().is_empty() {
-            Path::new(".")
-        } else {
-            dir
-        };
+        let dir = if dir.as_os_str().is_empty() { Path::new(".") } else { dir };
         if let Ok(d) = File::open(dir) {
             let _ = d.sync_all();
         }
@@ -901,50 +745,36 @@ impl<'a> Dec<'a> {
                 self.pos = end;
                 Ok(s)
             }
-            _ => Err(format!(
-                "section {} ends early (wanted {n} more bytes at offset {})",
-                self.what, self.pos
-            )),
+            _ => Err(format!("section {} ends early (wanted {n} more bytes at offset {})", self.what, self.pos)),
         }
     }
     fn u32(&mut self) -> Result<u32, String> {
-        Ok(u32::from_le_bytes(
-            self.take(4)?.try_into().expect("4 bytes"),
-        ))
+        Ok(u32::from_le_bytes(self.take(4)?.try_into().expect("4 bytes")))
     }
     fn u64(&mut self) -> Result<u64, String> {
-        Ok(u64::from_le_bytes(
-            self.take(8)?.try_into().expect("8 bytes"),
-        ))
+        Ok(u64::from_le_bytes(self.take(8)?.try_into().expect("8 bytes")))
     }
     fn usize(&mut self) -> Result<usize, String> {
         let v = self.u64()?;
         usize::try_from(v).map_err(|_| format!("section {}: value {v} out of range", self.what))
     }
     fn f64(&mut self) -> Result<Real, String> {
-        Ok(Real::from_le_bytes(
-            self.take(8)?.try_into().expect("8 bytes"),
-        ))
+        Ok(Real::from_le_bytes(self.take(8)?.try_into().expect("8 bytes")))
     }
     fn str(&mut self) -> Result<String, String> {
         let n = self.usize()?;
-        String::from_utf8(self.take(n)?.to_vec())
-            .map_err(|_| format!("section {}: text is not UTF-8", self.what))
+        String::from_utf8(self.take(n)?.to_vec()).map_err(|_| format!("section {}: text is not UTF-8", self.what))
     }
     /// A column's bytes: count, then `count × size` bytes (checked before
     /// anything is allocated).
     fn column(&mut self, size: usize) -> Result<(usize, &'a [u8]), String> {
         let n = self.usize()?;
-        let bytes = n
-            .checked_mul(size)
-            .ok_or_else(|| format!("section {}: column length {n} overflows", self.what))?;
+        let bytes = n.checked_mul(size).ok_or_else(|| format!("section {}: column length {n} overflows", self.what))?;
         Ok((n, self.take(bytes)?))
     }
     fn f64s(&mut self) -> Result<Vec<Real>, String> {
         let (_, b) = self.column(8)?;
-        Ok(b.chunks_exact(8)
-            .map(|c| Real::from_le_bytes(c.try_into().expect("8 bytes")))
-            .collect())
+        Ok(b.chunks_exact(8).map(|c| Real::from_le_bytes(c.try_into().expect("8 bytes"))).collect())
     }
     fn v2s(&mut self) -> Result<Vec<Vec2>, String> {
         let (_, b) = self.column(16)?;
@@ -960,33 +790,24 @@ impl<'a> Dec<'a> {
         let (_, b) = self.column(72)?;
         Ok(b.chunks_exact(72)
             .map(|c| {
-                let v: Vec<Real> = c
-                    .chunks_exact(8)
-                    .map(|x| Real::from_le_bytes(x.try_into().expect("8 bytes")))
-                    .collect();
+                let v: Vec<Real> =
+                    c.chunks_exact(8).map(|x| Real::from_le_bytes(x.try_into().expect("8 bytes"))).collect();
                 Tensor3::from_column_slice(&v)
             })
             .collect())
     }
     fn u32s(&mut self) -> Result<Vec<u32>, String> {
         let (_, b) = self.column(4)?;
-        Ok(b.chunks_exact(4)
-            .map(|c| u32::from_le_bytes(c.try_into().expect("4 bytes")))
-            .collect())
+        Ok(b.chunks_exact(4).map(|c| u32::from_le_bytes(c.try_into().expect("4 bytes"))).collect())
     }
     fn u64s(&mut self) -> Result<Vec<u64>, String> {
         let (_, b) = self.column(8)?;
-        Ok(b.chunks_exact(8)
-            .map(|c| u64::from_le_bytes(c.try_into().expect("8 bytes")))
-            .collect())
+        Ok(b.chunks_exact(8).map(|c| u64::from_le_bytes(c.try_into().expect("8 bytes"))).collect())
     }
     fn usizes(&mut self) -> Result<Vec<usize>, String> {
         self.u64s()?
             .into_iter()
-            .map(|v| {
-                usize::try_from(v)
-                    .map_err(|_| format!("section {}: value {v} out of range", self.what))
-            })
+            .map(|v| usize::try_from(v).map_err(|_| format!("section {}: value {v} out of range", self.what)))
             .collect()
     }
     fn u8s(&mut self) -> Result<Vec<u8>, String> {
@@ -996,11 +817,7 @@ impl<'a> Dec<'a> {
         if self.pos == self.b.len() {
             Ok(())
         } else {
-            Err(format!(
-                "section {} has {} unread bytes",
-                self.what,
-                self.b.len() - self.pos
-            ))
+            Err(format!("section {} has {} unread bytes", self.what, self.b.len() - self.pos))
         }
     }
 }
@@ -1019,21 +836,13 @@ fn sections(payload: &[u8]) -> Result<Sections<'_>, String> {
         if &tag == b"END!" {
             break;
         }
-        const KNOWN: [&[u8; 4]; 10] = [
-            b"META", b"PART", b"QUAD", b"QTAB", b"PTAB", b"GATH", b"BODY", b"FCON", b"CONT",
-            b"CRAK",
-        ];
+        const KNOWN: [&[u8; 4]; 10] =
+            [b"META", b"PART", b"QUAD", b"QTAB", b"PTAB", b"GATH", b"BODY", b"FCON", b"CONT", b"CRAK"];
         if !KNOWN.contains(&&tag) {
-            return Err(format!(
-                "unknown section '{}'",
-                String::from_utf8_lossy(&tag)
-            ));
+            return Err(format!("unknown section '{}'", String::from_utf8_lossy(&tag)));
         }
         if out.iter().any(|(t, _)| *t == tag) {
-            return Err(format!(
-                "section '{}' appears twice",
-                String::from_utf8_lossy(&tag)
-            ));
+            return Err(format!("section '{}' appears twice", String::from_utf8_lossy(&tag)));
         }
         out.push((tag, body));
     }
@@ -1063,48 +872,30 @@ fn read_table(d: &mut Dec, rows: usize, columns: usize, what: &str) -> Result<Sh
         && grad.len() == nnz
         && index.iter().all(|&i| (i as usize) < columns);
     if !ok {
-        return Err(format!(
-            "{what} shape table is inconsistent with {rows} rows and {columns} particles"
-        ));
+        return Err(format!("{what} shape table is inconsistent with {rows} rows and {columns} particles"));
     }
-    Ok(ShapeTable {
-        offsets,
-        index,
-        value,
-        grad,
-    })
+    Ok(ShapeTable { offsets, index, value, grad })
 }
 
 fn same_len(what: &str, n: usize, lens: &[usize]) -> Result<(), String> {
     if lens.iter().all(|&l| l == n) {
         Ok(())
     } else {
-        Err(format!(
-            "{what} columns have different lengths ({lens:?}, expected {n})"
-        ))
+        Err(format!("{what} columns have different lengths ({lens:?}, expected {n})"))
     }
 }
 
 /// Read a checkpoint file: header, version, checksum, then the state.
 pub fn read(path: &Path) -> Result<Restored, CheckpointError> {
-    let bytes = std::fs::read(path).map_err(|source| CheckpointError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    let damaged = |reason: String| CheckpointError::Damaged {
-        path: path.to_path_buf(),
-        reason,
-    };
+    let bytes = std::fs::read(path).map_err(|source| CheckpointError::Io { path: path.to_path_buf(), source })?;
+    let damaged = |reason: String| CheckpointError::Damaged { path: path.to_path_buf(), reason };
     if bytes.len() < 8 || bytes[..8] != MAGIC {
-        return Err(CheckpointError::NotACheckpoint {
-            path: path.to_path_buf(),
-        });
+        return Err(CheckpointError::NotACheckpoint { path: path.to_path_buf() });
     }
     let mut h = Dec::new(&bytes[8..], "header");
     let version = h.u32().map_err(damaged)?;
     let writer_len = h.u32().map_err(damaged)? as usize;
-    let writer =
-        String::from_utf8_lossy(h.take(writer_len.min(4096)).map_err(damaged)?).to_string();
+    let writer = String::from_utf8_lossy(h.take(writer_len.min(4096)).map_err(damaged)?).to_string();
     if version != FORMAT_VERSION {
         return Err(CheckpointError::Version {
             path: path.to_path_buf(),
@@ -1117,10 +908,7 @@ pub fn read(path: &Path) -> Result<Restored, CheckpointError> {
     let crc = h.u32().map_err(damaged)?;
     let payload = &bytes[8 + h.pos..];
     if payload.len() as u64 != payload_len {
-        return Err(damaged(format!(
-            "{} payload bytes, the header says {payload_len} (truncated?)",
-            payload.len()
-        )));
+        return Err(damaged(format!("{} payload bytes, the header says {payload_len} (truncated?)", payload.len())));
     }
     if crc32fast::hash(payload) != crc {
         return Err(damaged("checksum mismatch".into()));
@@ -1129,25 +917,12 @@ pub fn read(path: &Path) -> Result<Restored, CheckpointError> {
     let mut meta = section(&all, b"META", "META").map_err(damaged)?;
     let case_text = meta.str().map_err(damaged)?;
     let case = Case::from_str_with(&case_text, &format!("<case in {}>", path.display()), &[])
-        .map_err(|e| CheckpointError::Case {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        })?;
+        .map_err(|e| CheckpointError::Case { path: path.to_path_buf(), message: e.to_string() })?;
     let (sim, progress) = restore(&all, &mut meta, &case).map_err(damaged)?;
-    Ok(Restored {
-        path: path.to_path_buf(),
-        writer,
-        case,
-        sim,
-        progress,
-    })
+    Ok(Restored { path: path.to_path_buf(), writer, case, sim, progress })
 }
 
-fn restore(
-    all: &Sections,
-    meta: &mut Dec,
-    case: &Case,
-) -> Result<(Simulation, RunProgress), String> {
+fn restore(all: &Sections, meta: &mut Dec, case: &Case) -> Result<(Simulation, RunProgress), String> {
     let time = meta.f64()?;
     let step = meta.u64()?;
     let dt = meta.f64()?;
@@ -1157,14 +932,7 @@ fn restore(
         *v = meta.f64()?;
     }
     let [kinetic, internal, rigid_kinetic, contact_work, rigid_work, initial_kinetic] = e;
-    let energies = Energies {
-        kinetic,
-        internal,
-        rigid_kinetic,
-        contact_work,
-        rigid_work,
-        initial_kinetic,
-    };
+    let energies = Energies { kinetic, internal, rigid_kinetic, contact_work, rigid_work, initial_kinetic };
     let progress = RunProgress {
         snapshot_times: meta.f64s()?,
         history_bytes: meta.u64()?,
@@ -1183,9 +951,7 @@ fn restore(
     };
     meta.finish()?;
     if heat_every == 0 || !(heat_pending.is_finite() && heat_pending >= 0.0) {
-        return Err(format!(
-            "conduction every {heat_every} steps with {heat_pending} s pending is not usable"
-        ));
+        return Err(format!("conduction every {heat_every} steps with {heat_pending} s pending is not usable"));
     }
     if !(dt.is_finite() && dt > 0.0 && time.is_finite()) {
         return Err(format!("time {time} s or step {dt} s is not usable"));
@@ -1286,13 +1052,8 @@ fn restore(
     let qp_shape = read_table(&mut section(all, b"QTAB", "QTAB")?, nq, n, "quadrature")?;
     let particle_shape = read_table(&mut section(all, b"PTAB", "PTAB")?, n, n, "particle")?;
     let mut d = section(all, b"GATH", "GATH")?;
-    let mut gather = Gather {
-        offsets: d.usizes()?,
-        entry: d.u32s()?,
-        point: d.u32s()?,
-        value: Vec::new(),
-        grad: Vec::new(),
-    };
+    let mut gather =
+        Gather { offsets: d.usizes()?, entry: d.u32s()?, point: d.u32s()?, value: Vec::new(), grad: Vec::new() };
     d.finish()?;
     let nnz = qp_shape.nnz();
     let gather_ok = gather.offsets.len() == n + 1
@@ -1319,17 +1080,9 @@ fn restore(
         let name = d.str()?;
         let v: Vec<usize> = (0..6).map(|_| d.usize()).collect::<Result<_, _>>()?;
         if name != s.name || v[0] > v[1] || v[1] > n || v[2] > v[3] || v[3] > nq {
-            return Err(format!(
-                "body '{name}' does not match the case or the stores"
-            ));
+            return Err(format!("body '{name}' does not match the case or the stores"));
         }
-        bodies.push(BodyInfo {
-            name,
-            particles: v[0]..v[1],
-            quad_points: v[2]..v[3],
-            columns: v[4],
-            rows: v[5],
-        });
+        bodies.push(BodyInfo { name, particles: v[0]..v[1], quad_points: v[2]..v[3], columns: v[4], rows: v[5] });
     }
     d.finish()?;
     if p.body.iter().chain(&q.body).any(|&b| b as usize >= nb) {
@@ -1340,23 +1093,12 @@ fn restore(
     let f_contact = d.v2s()?;
     d.finish()?;
     if f_contact.len() != n {
-        return Err(format!(
-            "{} contact forces for {n} particles",
-            f_contact.len()
-        ));
+        return Err(format!("{} contact forces for {n} particles", f_contact.len()));
     }
 
     let materials = setups.into_iter().map(|s| s.material).collect();
-    let model = Model {
-        mode: case.geometry.mode,
-        particles,
-        quad,
-        materials,
-        bodies,
-        qp_shape,
-        particle_shape,
-        gather,
-    };
+    let model =
+        Model { mode: case.geometry.mode, particles, quad, materials, bodies, qp_shape, particle_shape, gather };
     let mut sim = Simulation::new(model, TimeStepRule::Fixed(dt));
     sim.time = time;
     sim.step = step;
@@ -1366,9 +1108,7 @@ fn restore(
     sim.driven_constraints = driven_constraints;
     sim.heat_every = heat_every;
     sim.heat_pending = heat_pending;
-    sim.heat = case
-        .heat_conduction_for(&sim.model)
-        .map_err(|e| format!("heat conduction: {e}"))?;
+    sim.heat = case.heat_conduction_for(&sim.model).map_err(|e| format!("heat conduction: {e}"))?;
     sim.contact = restore_contact(all, case, n)?;
     sim.cracks = restore_cracks(all, case, &sim.model)?;
     Ok((sim, progress))
@@ -1377,11 +1117,7 @@ fn restore(
 fn restore_contact(all: &Sections, case: &Case, n: usize) -> Result<Option<ContactSystem>, String> {
     let stored = all.iter().any(|(t, _)| t == b"CONT");
     if case.rigid_bodies.is_empty() {
-        return if stored {
-            Err("contact state without rigid bodies in the case".into())
-        } else {
-            Ok(None)
-        };
+        return if stored { Err("contact state without rigid bodies in the case".into()) } else { Ok(None) };
     }
     let mut d = section(all, b"CONT", "CONT")?;
     let mut bodies = case.rigid_bodies().map_err(|e| e.to_string())?;
@@ -1403,9 +1139,7 @@ fn restore_contact(all: &Sections, case: &Case, n: usize) -> Result<Option<Conta
     if kind.len() != ns || body.len() != ns || feature.len() != ns {
         return Err("slave pairing columns have different lengths".into());
     }
-    if particles.windows(2).any(|w| w[0] >= w[1])
-        || particles.last().is_some_and(|&i| i as usize >= n)
-    {
+    if particles.windows(2).any(|w| w[0] >= w[1]) || particles.last().is_some_and(|&i| i as usize >= n) {
         return Err("slave particles are not ascending particle indices".into());
     }
     let mut slaves = SlaveSet::from_indices(particles.iter().map(|&i| i as usize));
@@ -1446,11 +1180,7 @@ const MAX_SEGMENT_CELLS: Real = 1e4;
 fn restore_cracks(all: &Sections, case: &Case, model: &Model) -> Result<Option<CrackGrowth>, String> {
     let stored = all.iter().any(|(t, _)| t == b"CRAK");
     if case.fracture.criterion == Criterion::None {
-        return if stored {
-            Err("crack state, but the case has no fracture criterion".into())
-        } else {
-            Ok(None)
-        };
+        return if stored { Err("crack state, but the case has no fracture criterion".into()) } else { Ok(None) };
     }
     let (n, nq) = (model.particles.len(), model.quad.len());
     let mut d = section(all, b"CRAK", "CRAK")?;
@@ -1464,7 +1194,8 @@ fn restore_cracks(all: &Sections, case: &Case, model: &Model) -> Result<Option<C
     for x in &mut v {
         *x = d.f64()?;
     }
-    let [critical_effective_strain, critical_damage, radius_factor, fan_angle, offset_ratio, nucleation_distance_factor] = v;
+    let [critical_effective_strain, critical_damage, radius_factor, fan_angle, offset_ratio, nucleation_distance_factor] =
+        v;
     let params = FractureParameters {
         criterion,
         critical_effective_strain,
@@ -1510,21 +1241,13 @@ fn restore_cracks(all: &Sections, case: &Case, model: &Model) -> Result<Option<C
         let vertices = (0..m)
             .map(|j| match tag[j] {
                 0 => Ok(CrackVertex { x0: x0[j], faces: None }),
-                1 if (left[j] as usize) < n && (right[j] as usize) < n => Ok(CrackVertex {
-                    x0: x0[j],
-                    faces: Some((left[j], right[j])),
-                }),
+                1 if (left[j] as usize) < n && (right[j] as usize) < n => {
+                    Ok(CrackVertex { x0: x0[j], faces: Some((left[j], right[j])) })
+                }
                 _ => Err(format!("crack {k}: vertex {j} has invalid faces")),
             })
             .collect::<Result<Vec<_>, String>>()?;
-        cracks.push(Crack {
-            id,
-            vertices,
-            tip,
-            offset,
-            nucleated,
-            arrested,
-        });
+        cracks.push(Crack { id, vertices, tip, offset, nucleated, arrested });
     }
     let (time, step, crack, kind) = (d.f64s()?, d.u64s()?, d.usizes()?, d.u8s()?);
     let (offsets, particles, value) = (d.usizes()?, d.usizes()?, d.f64s()?);
@@ -1588,14 +1311,7 @@ fn restore_cracks(all: &Sections, case: &Case, model: &Model) -> Result<Option<C
         }
     }
     let [reduced_quadrature_rows, reduced_particle_rows] = reduced;
-    Ok(Some(CrackGrowth::from_state(
-        params,
-        cracks,
-        events,
-        reduced_quadrature_rows,
-        reduced_particle_rows,
-        model,
-    )))
+    Ok(Some(CrackGrowth::from_state(params, cracks, events, reduced_quadrature_rows, reduced_particle_rows, model)))
 }
 
 #[cfg(test)]
@@ -1614,20 +1330,10 @@ mod tests {
 
     #[test]
     fn columns_round_trip_bit_for_bit() {
-        let reals = [
-            0.0,
-            -0.0,
-            1.5e-300,
-            Real::MAX,
-            Real::NAN,
-            Real::INFINITY,
-            1.0 / 3.0,
-        ];
+        let reals = [0.0, -0.0, 1.5e-300, Real::MAX, Real::NAN, Real::INFINITY, 1.0 / 3.0];
         let v2: Vec<Vec2> = reals.iter().map(|&x| Vec2::new(x, -x)).collect();
-        let t3: Vec<Tensor3> = reals
-            .iter()
-            .map(|&x| Tensor3::from_fn(|i, j| x * (i as Real + 3.0 * j as Real)))
-            .collect();
+        let t3: Vec<Tensor3> =
+            reals.iter().map(|&x| Tensor3::from_fn(|i, j| x * (i as Real + 3.0 * j as Real))).collect();
         let mut e = Enc { w: Vec::new() };
         e.col(&Col::F64(&reals)).unwrap();
         e.col(&Col::V2(&v2)).unwrap();
@@ -1643,17 +1349,8 @@ mod tests {
         );
         let back = d.t3s().unwrap();
         assert_eq!(
-            bits(
-                &back
-                    .iter()
-                    .flat_map(|t| t.as_slice().to_vec())
-                    .collect::<Vec<_>>()
-            ),
-            bits(
-                &t3.iter()
-                    .flat_map(|t| t.as_slice().to_vec())
-                    .collect::<Vec<_>>()
-            )
+            bits(&back.iter().flat_map(|t| t.as_slice().to_vec()).collect::<Vec<_>>()),
+            bits(&t3.iter().flat_map(|t| t.as_slice().to_vec()).collect::<Vec<_>>())
         );
         assert_eq!(d.u32s().unwrap(), vec![1, u32::MAX]);
         d.finish().unwrap();

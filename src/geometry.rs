@@ -39,7 +39,13 @@ impl GeometryMode {
     /// the axis (Gauss points are interior to their cells), and at `R = 0`
     /// its limit `∂u_r/∂R` is used.
     #[inline]
-    pub fn deformation_gradient(self, grad_u: &nalgebra::Matrix2<Real>, u: &Vec2, x0: &Vec2, identity_part: Real) -> Tensor3 {
+    pub fn deformation_gradient(
+        self,
+        grad_u: &nalgebra::Matrix2<Real>,
+        u: &Vec2,
+        x0: &Vec2,
+        identity_part: Real,
+    ) -> Tensor3 {
         let mut f = Tensor3::zeros();
         for i in 0..2 {
             for j in 0..2 {
@@ -64,10 +70,8 @@ impl GeometryMode {
     /// on the radial component ([RL10, Eq. (2.31)], SPEC §4).
     #[inline]
     pub fn internal_force(self, pw: &Tensor3, n: Real, grad_n: &Vec2, x0_q: &Vec2) -> Vec2 {
-        let mut f = Vec2::new(
-            pw[(0, 0)] * grad_n.x + pw[(0, 1)] * grad_n.y,
-            pw[(1, 0)] * grad_n.x + pw[(1, 1)] * grad_n.y,
-        );
+        let mut f =
+            Vec2::new(pw[(0, 0)] * grad_n.x + pw[(0, 1)] * grad_n.y, pw[(1, 0)] * grad_n.x + pw[(1, 1)] * grad_n.y);
         if self == GeometryMode::Axisymmetric {
             f.x += pw[(2, 2)] * n / x0_q.x;
         }
@@ -85,7 +89,12 @@ mod tests {
         let e = 0.01;
         let g = nalgebra::Matrix2::new(e, 0.0, 0.0, 0.0);
         let x0 = Vec2::new(0.3, 0.1);
-        let f = GeometryMode::Axisymmetric.deformation_gradient(&g, &(x0 * e).component_mul(&Vec2::new(1.0, 0.0)), &x0, 1.0);
+        let f = GeometryMode::Axisymmetric.deformation_gradient(
+            &g,
+            &(x0 * e).component_mul(&Vec2::new(1.0, 0.0)),
+            &x0,
+            1.0,
+        );
         assert!((f[(0, 0)] - 1.01).abs() < 1e-15);
         assert!((f[(2, 2)] - 1.01).abs() < 1e-15);
         let fp = GeometryMode::PlaneStrain.deformation_gradient(&g, &Vec2::new(0.003, 0.0), &x0, 1.0);

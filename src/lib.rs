@@ -2,26 +2,26 @@
 //! plugging and ductile fracture. See `ARCHITECTURE.md` for the module map
 //! and `SPEC.md` (shared) for the physics.
 
+pub mod bench;
+pub mod case;
+pub mod cases;
+pub mod checkpoint;
 pub mod contact;
+pub mod discretize;
+pub mod fracture;
+pub mod geometry;
 pub mod io;
 pub mod kernel;
 pub mod material;
+pub mod material_point;
 pub mod math;
+pub mod memory;
+pub mod model;
+pub mod neighbors;
+pub mod output;
 pub mod particles;
 pub mod quadrature;
+pub mod run;
 pub mod shape;
-pub mod discretize;
-pub mod geometry;
-pub mod model;
-pub mod fracture;
-pub mod neighbors;
 pub mod step;
 pub mod thermal;
-pub mod case;
-pub mod output;
-pub mod run;
-pub mod checkpoint;
-pub mod memory;
-pub mod cases;
-pub mod material_point;
-pub mod bench;

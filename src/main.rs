@@ -118,7 +118,10 @@ fn load(case_file: &Option<PathBuf>, builtin: &Option<String>, set: &[String]) -
         }
         (None, Some(name)) => {
             let Some(text) = builtin_case(name) else {
-                bail!("unknown built-in case '{name}'; available: {}", BUILTIN_CASES.iter().map(|c| c.0).collect::<Vec<_>>().join(", "))
+                bail!(
+                    "unknown built-in case '{name}'; available: {}",
+                    BUILTIN_CASES.iter().map(|c| c.0).collect::<Vec<_>>().join(", ")
+                )
             };
             let file = format!("<built-in {name}>");
             let case = Case::from_str_with(text, &file, set)?;
@@ -172,7 +175,12 @@ fn dispatch(cmd: Command) -> Result<()> {
             let out_dir = out
                 .or_else(|| case.output.directory.as_ref().map(PathBuf::from))
                 .unwrap_or_else(|| Path::new("runs").join(&name));
-            let cfg = RunConfig { out_dir, force, info: RunInfo::current(&file, &set), interrupt: install_interrupt_handler() };
+            let cfg = RunConfig {
+                out_dir,
+                force,
+                info: RunInfo::current(&file, &set),
+                interrupt: install_interrupt_handler(),
+            };
             drive(&cfg, |cfg, report| execute(&case, cfg, report))
         }
         Command::Resume { dir } => {
@@ -198,7 +206,9 @@ fn install_interrupt_handler() -> Option<Arc<AtomicBool>> {
             eprintln!("\nplugsim: second interrupt: stopping now, without a new checkpoint");
             std::process::exit(130);
         }
-        eprintln!("\nplugsim: interrupted: finishing this step and writing a checkpoint (interrupt again to stop at once)");
+        eprintln!(
+            "\nplugsim: interrupted: finishing this step and writing a checkpoint (interrupt again to stop at once)"
+        );
     };
     match ctrlc::set_handler(handler) {
         Ok(()) => Some(flag),
@@ -209,13 +219,23 @@ fn install_interrupt_handler() -> Option<Arc<AtomicBool>> {
     }
 }
 
-fn material_point(name: &str, case_file: Option<&Path>, path: PathArg, rate: f64, strain: f64, dt: Option<f64>, out: &Path) -> Result<()> {
+fn material_point(
+    name: &str,
+    case_file: Option<&Path>,
+    path: PathArg,
+    rate: f64,
+    strain: f64,
+    dt: Option<f64>,
+    out: &Path,
+) -> Result<()> {
     use plugsim::material_point::{run, save_csv, save_plots, DriverConfig, LoadPath};
     let mat = match case_file {
         Some(f) => Case::load(f, &[])?.material(name),
         None => plugsim::material::builtin(name),
     }
-    .with_context(|| format!("unknown material '{name}' (built-in: {})", plugsim::material::builtin_names().join(", ")))?;
+    .with_context(|| {
+        format!("unknown material '{name}' (built-in: {})", plugsim::material::builtin_names().join(", "))
+    })?;
     let load = match path {
         PathArg::UniaxialStrain => LoadPath::UniaxialStrain,
         PathArg::UniaxialStress => LoadPath::UniaxialStress,
@@ -247,9 +267,17 @@ fn bench(name: &str, steps: usize, whole: Option<f64>, set: &[String]) -> Result
     let all = rayon::current_num_threads();
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
-        .and_then(|s| s.lines().find(|l| l.starts_with("model name")).map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string()))
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
         .unwrap_or_else(|| "unknown CPU".into());
-    println!("plugsim bench {} ({}) on {cpu}, {all} threads available", env!("CARGO_PKG_VERSION"), env!("PLUGSIM_COMMIT"));
+    println!(
+        "plugsim bench {} ({}) on {cpu}, {all} threads available",
+        env!("CARGO_PKG_VERSION"),
+        env!("PLUGSIM_COMMIT")
+    );
     println!("case {name}: {}", case.title);
     let show = |f: &bench::Figure| println!("  {:70} {:>12.4e} {}", f.name, f.value, f.unit);
     let material = plugsim::material::builtin("weldox_460e").context("built-in material")?;
@@ -320,14 +348,25 @@ fn check(case: &Case, file: &str) -> Result<()> {
     }
     if let Some(c) = &sim.contact {
         for b in &c.bodies {
-            println!("  rigid body {:10} mass {:.6e} kg, velocity ({:.2}, {:.2}) m/s", b.name, b.mass, b.velocity.x, b.velocity.y);
+            println!(
+                "  rigid body {:10} mass {:.6e} kg, velocity ({:.2}, {:.2}) m/s",
+                b.name, b.mass, b.velocity.x, b.velocity.y
+            );
         }
         println!("  contact slaves  {} surface particles", c.slaves.len());
     }
-    println!("  time step       {:.3e} s ({} steps to {:.3e} s)", sim.dt, (resolved.time.end / sim.dt).ceil(), resolved.time.end);
+    println!(
+        "  time step       {:.3e} s ({} steps to {:.3e} s)",
+        sim.dt,
+        (resolved.time.end / sim.dt).ceil(),
+        resolved.time.end
+    );
     let cfl = sim.model.min_spacing() / sim.model.max_wave_speed();
     if sim.dt > cfl {
-        println!("  WARNING: the time step is {:.1} times the CFL limit {cfl:.3e} s; the run may go unstable", sim.dt / cfl);
+        println!(
+            "  WARNING: the time step is {:.1} times the CFL limit {cfl:.3e} s; the run may go unstable",
+            sim.dt / cfl
+        );
     }
     let (available, origin) = plugsim::memory::available_memory();
     println!(
@@ -343,7 +382,10 @@ fn check(case: &Case, file: &str) -> Result<()> {
 
 /// Run `job` (a fresh run or a resume) with a progress bar or progress lines,
 /// then print the summary.
-fn drive(cfg: &RunConfig, job: impl FnOnce(&RunConfig, &mut dyn FnMut(Progress)) -> Result<RunSummary, RunError>) -> Result<()> {
+fn drive(
+    cfg: &RunConfig,
+    job: impl FnOnce(&RunConfig, &mut dyn FnMut(Progress)) -> Result<RunSummary, RunError>,
+) -> Result<()> {
     let out_dir = cfg.out_dir.clone();
     let tty = std::io::stderr().is_terminal();
     let bar = ProgressBar::hidden();
@@ -420,12 +462,22 @@ fn drive(cfg: &RunConfig, job: impl FnOnce(&RunConfig, &mut dyn FnMut(Progress))
     if s.max_drift > 0.05 {
         println!("  WARNING: the energy balance drifted by more than 5 % of the input energy");
     }
-    println!("  wall time {:.2} s: setup {:.2} s, time loop {:.2} s, output {:.2} s", total.as_secs_f64(), s.setup_wall.as_secs_f64(), s.loop_wall.as_secs_f64(), s.output_wall.as_secs_f64());
+    println!(
+        "  wall time {:.2} s: setup {:.2} s, time loop {:.2} s, output {:.2} s",
+        total.as_secs_f64(),
+        s.setup_wall.as_secs_f64(),
+        s.loop_wall.as_secs_f64(),
+        s.output_wall.as_secs_f64()
+    );
     for (name, d) in &s.stage_timers {
         println!("    {name:30} {:8.3} s", d.as_secs_f64());
     }
     let qp_rate = s.quadrature_points as f64 * s.steps as f64 / s.loop_wall.as_secs_f64().max(1e-9);
-    println!("  throughput {:.3e} quadrature-point updates/s, {:.1} steps/s", qp_rate, s.steps as f64 / s.loop_wall.as_secs_f64().max(1e-9));
+    println!(
+        "  throughput {:.3e} quadrature-point updates/s, {:.1} steps/s",
+        qp_rate,
+        s.steps as f64 / s.loop_wall.as_secs_f64().max(1e-9)
+    );
     for (name, v) in &s.rigid_velocities {
         println!("  rigid body {name}: final velocity ({:.2}, {:.2}) m/s", v[0], v[1]);
     }

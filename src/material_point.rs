@@ -35,8 +35,8 @@ use std::ffi::OsString;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use crate::material::{Constitutive, Material, PointState, StepKinematics};
 use crate::io::plot::{save_line_plot, LinePlot, PlotError, Series};
+use crate::material::{Constitutive, Material, PointState, StepKinematics};
 use crate::math::{mean_stress, von_mises, Real, Tensor3};
 
 /// The most steps one run may take (each step keeps a [`Record`], ~170 bytes).
@@ -118,11 +118,7 @@ pub struct Record {
 pub enum DriverError {
     /// A configuration value out of range.
     #[error("driver setting `{field}` = {value}: {reason}")]
-    InvalidConfig {
-        field: &'static str,
-        value: Real,
-        reason: &'static str,
-    },
+    InvalidConfig { field: &'static str, value: Real, reason: &'static str },
     /// The material's parameters are invalid (all problems listed).
     #[error("invalid material: {}", .0.iter().map(|e| e.to_string()).collect::<Vec<_>>().join("; "))]
     InvalidMaterial(Vec<crate::material::johnson_cook::ParameterError>),
@@ -131,11 +127,7 @@ pub enum DriverError {
     LateralStressNotConverged { step: usize, residual: Real },
     /// The material returned a NaN or infinite state.
     #[error("non-finite {field} at step {step} (t = {time} s)")]
-    NonFinite {
-        step: usize,
-        time: Real,
-        field: &'static str,
-    },
+    NonFinite { step: usize, time: Real, field: &'static str },
     /// Writing output failed.
     #[error("cannot write {path}: {source}")]
     Io {
@@ -158,9 +150,7 @@ pub fn run(material: &Material, config: &DriverConfig) -> Result<Vec<Record>, Dr
     let t_end = config.final_strain.abs() / config.rate;
     let h = t_end / steps as Real;
     let signed_rate = config.rate * config.final_strain.signum();
-    let t0 = config
-        .initial_temperature
-        .unwrap_or_else(|| material.initial_temperature());
+    let t0 = config.initial_temperature.unwrap_or_else(|| material.initial_temperature());
 
     let mut state = PointState::at_rest(t0);
     let mut jacobian = 1.0;
@@ -171,30 +161,19 @@ pub fn run(material: &Material, config: &DriverConfig) -> Result<Vec<Record>, Dr
         let (next, d) = match config.path {
             LoadPath::UniaxialStrain => {
                 let d = Tensor3::from_diagonal(&nalgebra::Vector3::new(signed_rate, 0.0, 0.0));
-                let k = StepKinematics {
-                    d,
-                    w: Tensor3::zeros(),
-                    dt: h,
-                };
+                let k = StepKinematics { d, w: Tensor3::zeros(), dt: h };
                 (material.update(&state, &k), d)
             }
             LoadPath::UniaxialStress => {
                 let (next, d_l) = solve_lateral(material, &state, signed_rate, lateral, h, step)?;
                 lateral = d_l;
-                (
-                    next,
-                    Tensor3::from_diagonal(&nalgebra::Vector3::new(signed_rate, d_l, d_l)),
-                )
+                (next, Tensor3::from_diagonal(&nalgebra::Vector3::new(signed_rate, d_l, d_l)))
             }
             LoadPath::SimpleShear => {
                 let mut l = Tensor3::zeros();
                 l[(0, 1)] = signed_rate;
                 let d = crate::math::sym(&l);
-                let k = StepKinematics {
-                    d,
-                    w: crate::math::skew(&l),
-                    dt: h,
-                };
+                let k = StepKinematics { d, w: crate::math::skew(&l), dt: h };
                 (material.update(&state, &k), d)
             }
         };
@@ -208,13 +187,7 @@ pub fn run(material: &Material, config: &DriverConfig) -> Result<Vec<Record>, Dr
 }
 
 fn check_config(c: &DriverConfig) -> Result<usize, DriverError> {
-    let bad = |field, value, reason| {
-        Err(DriverError::InvalidConfig {
-            field,
-            value,
-            reason,
-        })
-    };
+    let bad = |field, value, reason| Err(DriverError::InvalidConfig { field, value, reason });
     if !(c.rate > 0.0 && c.rate.is_finite()) {
         return bad("rate", c.rate, "must be positive and finite");
     }
@@ -226,20 +199,12 @@ fn check_config(c: &DriverConfig) -> Result<usize, DriverError> {
     }
     if let Some(t) = c.initial_temperature {
         if !(t >= 0.0 && t.is_finite()) {
-            return bad(
-                "initial_temperature",
-                t,
-                "must be a finite absolute temperature",
-            );
+            return bad("initial_temperature", t, "must be a finite absolute temperature");
         }
     }
     let steps = (c.final_strain.abs() / c.rate / c.dt).ceil();
     if steps > MAX_STEPS as Real {
-        return bad(
-            "dt",
-            c.dt,
-            "needs more than MAX_STEPS steps to reach final_strain",
-        );
+        return bad("dt", c.dt, "needs more than MAX_STEPS steps to reach final_strain");
     }
     Ok((steps as usize).max(1))
 }
@@ -263,14 +228,7 @@ fn solve_lateral(
     const MAX_ITERATIONS: usize = 60;
     let trial = |d_l: Real| {
         let d = Tensor3::from_diagonal(&nalgebra::Vector3::new(axial, d_l, d_l));
-        let next = material.update(
-            state,
-            &StepKinematics {
-                d,
-                w: Tensor3::zeros(),
-                dt,
-            },
-        );
+        let next = material.update(state, &StepKinematics { d, w: Tensor3::zeros(), dt });
         (next, next.tau[(1, 1)])
     };
     let converged = |s: &PointState, r: Real| {
@@ -330,8 +288,7 @@ fn record(time: Real, strain: Real, s: &PointState, jacobian: Real) -> Record {
 }
 
 /// CSV header written by [`write_csv`]; units: s, Pa, K, 1/s.
-pub const CSV_HEADER: &str =
-    "time,strain,equivalent_stress,pressure,eps_p,eps_p_rate,temperature,damage,\
+pub const CSV_HEADER: &str = "time,strain,equivalent_stress,pressure,eps_p,eps_p_rate,temperature,damage,\
 tau_xx,tau_yy,tau_zz,tau_xy,tau_yz,tau_xz,jacobian";
 
 /// Write `records` as CSV ([`CSV_HEADER`], one row per record, numbers in
@@ -365,10 +322,7 @@ pub fn write_csv<W: Write>(records: &[Record], mut out: W) -> std::io::Result<()
 
 /// [`write_csv`] to the file `path`.
 pub fn save_csv(path: &Path, records: &[Record]) -> Result<(), DriverError> {
-    let io_err = |source| DriverError::Io {
-        path: path.display().to_string(),
-        source,
-    };
+    let io_err = |source| DriverError::Io { path: path.display().to_string(), source };
     let file = std::fs::File::create(path).map_err(io_err)?;
     let mut out = std::io::BufWriter::new(file);
     write_csv(records, &mut out).map_err(io_err)?;
@@ -418,10 +372,7 @@ pub fn line_plots(records: &[Record], path: LoadPath) -> Vec<(&'static str, Line
                 title: "Damage and plastic strain".into(),
                 x_label,
                 y_label: "[-]".into(),
-                series: vec![
-                    curve("damage D", &|r| r.damage),
-                    curve("plastic strain", &|r| r.eps_p),
-                ],
+                series: vec![curve("damage D", &|r| r.damage), curve("plastic strain", &|r| r.eps_p)],
                 hlines: vec![("failure D = 1".into(), 1.0)],
             },
         ),
@@ -430,11 +381,7 @@ pub fn line_plots(records: &[Record], path: LoadPath) -> Vec<(&'static str, Line
 
 /// Render [`line_plots`] to `<stem>_stress.png`, `<stem>_temperature.png` and
 /// `<stem>_damage.png`; returns the paths written.
-pub fn save_plots(
-    stem: &Path,
-    records: &[Record],
-    path: LoadPath,
-) -> Result<Vec<PathBuf>, DriverError> {
+pub fn save_plots(stem: &Path, records: &[Record], path: LoadPath) -> Result<Vec<PathBuf>, DriverError> {
     let mut written = Vec::new();
     for (suffix, plot) in line_plots(records, path) {
         let mut name: OsString = stem.as_os_str().to_os_string();
@@ -463,22 +410,12 @@ mod tests {
     }
 
     fn config(path: LoadPath, rate: Real, final_strain: Real, dt: Real) -> DriverConfig {
-        DriverConfig {
-            path,
-            rate,
-            final_strain,
-            dt,
-            initial_temperature: None,
-        }
+        DriverConfig { path, rate, final_strain, dt, initial_temperature: None }
     }
 
     #[test]
     fn steps_land_exactly_on_the_final_strain() {
-        let r = run(
-            &steel(),
-            &config(LoadPath::UniaxialStrain, 1e3, -0.01, 3e-7),
-        )
-        .unwrap();
+        let r = run(&steel(), &config(LoadPath::UniaxialStrain, 1e3, -0.01, 3e-7)).unwrap();
         // t_end = 1e-5 s, ceil(1e-5 / 3e-7) = 34 steps.
         assert_eq!(r.len(), 35);
         assert!((r.last().unwrap().strain + 0.01).abs() < 1e-15);
@@ -495,10 +432,7 @@ mod tests {
             other => panic!("{other:?}"),
         };
         bad(config(LoadPath::SimpleShear, 0.0, 0.1, 1e-6), "rate");
-        bad(
-            config(LoadPath::SimpleShear, 1.0, 0.0, 1e-6),
-            "final_strain",
-        );
+        bad(config(LoadPath::SimpleShear, 1.0, 0.0, 1e-6), "final_strain");
         bad(config(LoadPath::SimpleShear, 1.0, 0.1, -1.0), "dt");
         bad(config(LoadPath::SimpleShear, 1.0, 1.0, 1e-12), "dt");
         let mut c = config(LoadPath::SimpleShear, 1.0, 0.1, 1e-3);
@@ -507,10 +441,7 @@ mod tests {
         let mut jc = weldox_460e();
         jc.rate_sensitivity = 0.0;
         jc.taylor_quinney = 2.0;
-        match run(
-            &Material::JohnsonCook(jc),
-            &config(LoadPath::SimpleShear, 1.0, 0.1, 1e-3),
-        ) {
+        match run(&Material::JohnsonCook(jc), &config(LoadPath::SimpleShear, 1.0, 0.1, 1e-3)) {
             Err(DriverError::InvalidMaterial(errors)) => assert_eq!(errors.len(), 2),
             other => panic!("{other:?}"),
         }
@@ -538,11 +469,7 @@ mod tests {
         let r = run(&steel(), &config(LoadPath::UniaxialStress, 1.0, 1e-3, 1e-5)).unwrap();
         let last = r.last().unwrap();
         // Hypoelastic, small strain: τ_xx = E ε to O(ε).
-        assert!(
-            (last.tau[(0, 0)] / 1e-3 / 200e9 - 1.0).abs() < 2e-3,
-            "{}",
-            last.tau[(0, 0)]
-        );
+        assert!((last.tau[(0, 0)] / 1e-3 / 200e9 - 1.0).abs() < 2e-3, "{}", last.tau[(0, 0)]);
         for rec in &r {
             assert!(rec.tau[(1, 1)].abs() <= 1e-9 * rec.tau[(0, 0)].abs().max(1.0));
             assert!(rec.tau[(2, 2)].abs() <= 1e-9 * rec.tau[(0, 0)].abs().max(1.0));
@@ -551,15 +478,8 @@ mod tests {
 
     #[test]
     fn uniaxial_stress_of_johnson_cook_keeps_lateral_stress_zero_through_yield() {
-        for m in [
-            weldox_460e(),
-            crate::material::library::weldox_460e_borvik(),
-        ] {
-            let r = run(
-                &Material::JohnsonCook(m),
-                &config(LoadPath::UniaxialStress, 1e3, 0.1, 1e-6),
-            )
-            .unwrap();
+        for m in [weldox_460e(), crate::material::library::weldox_460e_borvik()] {
+            let r = run(&Material::JohnsonCook(m), &config(LoadPath::UniaxialStress, 1e3, 0.1, 1e-6)).unwrap();
             let last = r.last().unwrap();
             assert!(last.eps_p > 0.09);
             for rec in &r {
@@ -572,20 +492,14 @@ mod tests {
 
     #[test]
     fn csv_round_trips_every_record() {
-        let r = run(
-            &Material::JohnsonCook(weldox_460e()),
-            &config(LoadPath::SimpleShear, 1e4, 0.2, 1e-6),
-        )
-        .unwrap();
+        let r = run(&Material::JohnsonCook(weldox_460e()), &config(LoadPath::SimpleShear, 1e4, 0.2, 1e-6)).unwrap();
         let mut buf = Vec::new();
         write_csv(&r, &mut buf).unwrap();
         let text = String::from_utf8(buf).unwrap();
         let mut lines = text.lines();
         assert_eq!(lines.next().unwrap(), CSV_HEADER);
         let columns = CSV_HEADER.split(',').count();
-        let rows: Vec<Vec<Real>> = lines
-            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-            .collect();
+        let rows: Vec<Vec<Real>> = lines.map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
         assert_eq!(rows.len(), r.len());
         for (row, rec) in rows.iter().zip(&r) {
             assert_eq!(row.len(), columns);
@@ -612,21 +526,14 @@ mod tests {
 
     #[test]
     fn plots_carry_the_records() {
-        let r = run(
-            &Material::JohnsonCook(weldox_460e()),
-            &config(LoadPath::SimpleShear, 1e4, 0.2, 1e-6),
-        )
-        .unwrap();
+        let r = run(&Material::JohnsonCook(weldox_460e()), &config(LoadPath::SimpleShear, 1e4, 0.2, 1e-6)).unwrap();
         let plots = line_plots(&r, LoadPath::SimpleShear);
         let names: Vec<&str> = plots.iter().map(|(n, _)| *n).collect();
         assert_eq!(names, ["stress", "temperature", "damage"]);
         let stress = &plots[0].1.series[0].points;
         assert_eq!(stress.len(), r.len());
         let last = r.last().unwrap();
-        assert_eq!(
-            *stress.last().unwrap(),
-            (last.strain, last.equivalent_stress * 1e-6)
-        );
+        assert_eq!(*stress.last().unwrap(), (last.strain, last.equivalent_stress * 1e-6));
         assert_eq!(plots[2].1.series[0].points.last().unwrap().1, last.damage);
     }
 }

@@ -94,10 +94,7 @@ impl std::ops::Add for Footprint {
 /// estimate within a few columns (`column_estimate_matches_the_generator`).
 /// Infinite or NaN for grids that make no sense (those fail validation).
 pub fn estimate_columns(grid: &RectangleGrid) -> Real {
-    let x_f = grid
-        .refine_at
-        .unwrap_or(0.5 * (grid.x_min + grid.x_max))
-        .clamp(grid.x_min, grid.x_max);
+    let x_f = grid.refine_at.unwrap_or(0.5 * (grid.x_min + grid.x_max)).clamp(grid.x_min, grid.x_max);
     let h_f = grid.fine_spacing.unwrap_or_else(|| grid.layer_spacing());
     let cap = grid.coarse_spacing.unwrap_or(Real::INFINITY).max(h_f);
     let side = |d: Real| -> Real {
@@ -115,11 +112,7 @@ pub fn estimate_columns(grid: &RectangleGrid) -> Real {
         } else {
             // Spacings h_f g, h_f g², ... up to the cap, then the cap.
             let ramp = |k: Real| h_f * g * (g.powf(k) - 1.0) / (g - 1.0);
-            let k_cap = if cap.is_finite() {
-                ((cap / h_f).ln() / g.ln()).max(0.0)
-            } else {
-                Real::INFINITY
-            };
+            let k_cap = if cap.is_finite() { ((cap / h_f).ln() / g.ln()).max(0.0) } else { Real::INFINITY };
             if k_cap.is_finite() && ramp(k_cap) < rest {
                 k_cap + (rest - ramp(k_cap)) / cap
             } else {
@@ -143,10 +136,7 @@ pub fn estimate_grid(grid: &RectangleGrid) -> Footprint {
     let rows = grid.layers as Real;
     let h_y = grid.layer_spacing();
     let h_f = grid.fine_spacing.unwrap_or(h_y);
-    let largest = grid
-        .coarse_spacing
-        .map_or(grid.x_max - grid.x_min, |c| c.max(h_f))
-        .max(h_f);
+    let largest = grid.coarse_spacing.map_or(grid.x_max - grid.x_min, |c| c.max(h_f)).max(h_f);
     let across = 2.0 * grid.support_factor + 1.0;
     let per_row = across * rows.min(across * (largest / h_y).max(1.0));
     let gauss = grid.gauss as Real;
@@ -163,21 +153,16 @@ pub fn estimate_grid(grid: &RectangleGrid) -> Footprint {
 /// Memory available to a new process, bytes, and where the figure came
 /// from: `MemAvailable` of `/proc/meminfo`, else [`FALLBACK_AVAILABLE_BYTES`].
 pub fn available_memory() -> (u64, &'static str) {
-    let from_proc = std::fs::read_to_string("/proc/meminfo")
-        .ok()
-        .and_then(|text| {
-            text.lines().find_map(|l| {
-                let rest = l.strip_prefix("MemAvailable:")?;
-                let kb: u64 = rest.trim().trim_end_matches("kB").trim().parse().ok()?;
-                Some(kb.saturating_mul(1024))
-            })
-        });
+    let from_proc = std::fs::read_to_string("/proc/meminfo").ok().and_then(|text| {
+        text.lines().find_map(|l| {
+            let rest = l.strip_prefix("MemAvailable:")?;
+            let kb: u64 = rest.trim().trim_end_matches("kB").trim().parse().ok()?;
+            Some(kb.saturating_mul(1024))
+        })
+    });
     match from_proc {
         Some(b) => (b, "MemAvailable in /proc/meminfo"),
-        None => (
-            FALLBACK_AVAILABLE_BYTES,
-            "a fixed 16 GiB: /proc/meminfo unreadable",
-        ),
+        None => (FALLBACK_AVAILABLE_BYTES, "a fixed 16 GiB: /proc/meminfo unreadable"),
     }
 }
 
@@ -191,13 +176,7 @@ pub enum MemoryError {
         human_bytes(*.needed), .footprint.particles, .footprint.quadrature_points,
         .footprint.quadrature_entries + .footprint.particle_entries, human_bytes(*.available as Real)
     )]
-    TooLarge {
-        footprint: Footprint,
-        needed: Real,
-        available: u64,
-        origin: &'static str,
-        body: String,
-    },
+    TooLarge { footprint: Footprint, needed: Real, available: u64, origin: &'static str, body: String },
     #[error(
         "body '{body}': {:.3e} shape-function entries exceed the solver's 32-bit index range ({:.3e}); \
          use fewer layers or larger spacings",
@@ -241,10 +220,7 @@ pub fn guard<'a>(
         });
     }
     if widest.1 > MAX_INDEX {
-        return Err(MemoryError::IndexRange {
-            body: widest.0,
-            entries: widest.1,
-        });
+        return Err(MemoryError::IndexRange { body: widest.0, entries: widest.1 });
     }
     Ok(total)
 }
@@ -270,13 +246,7 @@ mod tests {
     use super::*;
     use crate::geometry::GeometryMode;
 
-    fn plate(
-        layers: usize,
-        half_width: Real,
-        growth: Real,
-        coarse: Option<Real>,
-        fine: Option<Real>,
-    ) -> RectangleGrid {
+    fn plate(layers: usize, half_width: Real, growth: Real, coarse: Option<Real>, fine: Option<Real>) -> RectangleGrid {
         RectangleGrid {
             x_min: -0.138,
             x_max: 0.138,
@@ -312,19 +282,13 @@ mod tests {
             g.resolve(GeometryMode::PlaneStrain);
             let actual = g.columns().len() as Real;
             let est = estimate_columns(&g);
-            assert!(
-                est >= actual - 2.0 && est <= 1.1 * actual + 6.0,
-                "estimate {est}, actual {actual}: {g:?}"
-            );
+            assert!(est >= actual - 2.0 && est <= 1.1 * actual + 6.0, "estimate {est}, actual {actual}: {g:?}");
         }
     }
 
     #[test]
     fn entry_estimate_errs_high_within_a_small_factor() {
-        for g in [
-            plate(12, 0.012, 1.1, Some(0.002), None),
-            plate(24, 0.02, 1.03, Some(0.0006), None),
-        ] {
+        for g in [plate(12, 0.012, 1.1, Some(0.002), None), plate(24, 0.02, 1.03, Some(0.0006), None)] {
             let mut g = g;
             g.resolve(GeometryMode::PlaneStrain);
             let e = estimate_grid(&g);
@@ -339,20 +303,9 @@ mod tests {
                 }],
             )
             .unwrap();
-            let (nq, np) = (
-                model.qp_shape.nnz() as Real,
-                model.particle_shape.nnz() as Real,
-            );
-            assert!(
-                e.quadrature_entries >= nq && e.quadrature_entries < 3.0 * nq,
-                "{} vs {nq}",
-                e.quadrature_entries
-            );
-            assert!(
-                e.particle_entries >= np && e.particle_entries < 3.0 * np,
-                "{} vs {np}",
-                e.particle_entries
-            );
+            let (nq, np) = (model.qp_shape.nnz() as Real, model.particle_shape.nnz() as Real);
+            assert!(e.quadrature_entries >= nq && e.quadrature_entries < 3.0 * nq, "{} vs {nq}", e.quadrature_entries);
+            assert!(e.particle_entries >= np && e.particle_entries < 3.0 * np, "{} vs {np}", e.particle_entries);
             assert!((e.particles - model.particles.len() as Real).abs() <= 0.1 * e.particles);
         }
     }
@@ -361,19 +314,13 @@ mod tests {
     fn absurd_grids_are_refused_fast() {
         let mut g = plate(24, 0.02, 1.03, Some(0.0006), Some(1e-300));
         g.resolve(GeometryMode::PlaneStrain);
-        let err = guard([("plate", &g)], (1 << 34, "test"))
-            .unwrap_err()
-            .to_string();
+        let err = guard([("plate", &g)], (1 << 34, "test")).unwrap_err().to_string();
         assert!(err.contains("available") && err.contains("plate"), "{err}");
         let g = plate(5000, 0.02, 1.03, Some(0.0006), None);
-        let err = guard([("plate", &g)], (u64::MAX, "test"))
-            .unwrap_err()
-            .to_string();
+        let err = guard([("plate", &g)], (u64::MAX, "test")).unwrap_err().to_string();
         assert!(err.contains("32-bit index range"), "{err}");
         let g = plate(100_000, 0.02, 1.03, Some(0.0006), None);
-        let err = guard([("plate", &g)], (1 << 34, "test"))
-            .unwrap_err()
-            .to_string();
+        let err = guard([("plate", &g)], (1 << 34, "test")).unwrap_err().to_string();
         assert!(err.contains("plate") && err.contains("available"), "{err}");
         let g = plate(24, 0.02, 1.03, Some(0.0006), None);
         let f = guard([("plate", &g)], (1 << 34, "test")).unwrap();

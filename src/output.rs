@@ -365,11 +365,7 @@ pub fn plot_history(dir: &Path) -> Result<Vec<PathBuf>, crate::run::RunError> {
 /// coloured by a projected quadrature field, with the crack faces drawn over
 /// them; `window` limits the view to `[x_min, x_max, y_min, y_max]` (m) in
 /// the reference configuration.
-pub fn field_plot(
-    sim: &Simulation,
-    field: &str,
-    window: Option<[Real; 4]>,
-) -> Option<crate::io::FieldPlot> {
+pub fn field_plot(sim: &Simulation, field: &str, window: Option<[Real; 4]>) -> Option<crate::io::FieldPlot> {
     let m = &sim.model;
     let q = &m.quad;
     let (values, label): (Vec<Real>, &str) = match field {
@@ -402,7 +398,10 @@ pub fn field_plot(
         title: format!("{label} at t = {:.1} us", sim.time * 1e6),
         x_label: "x (mm)".into(),
         y_label: "y (mm)".into(),
-        points: idx.iter().map(|&i| ((m.particles.x0[i].x + u[i].x) * 1e3, (m.particles.x0[i].y + u[i].y) * 1e3)).collect(),
+        points: idx
+            .iter()
+            .map(|&i| ((m.particles.x0[i].x + u[i].x) * 1e3, (m.particles.x0[i].y + u[i].y) * 1e3))
+            .collect(),
         values: idx.iter().map(|&i| values[i]).collect(),
         value_label: label.into(),
         lines,
@@ -414,7 +413,8 @@ pub fn field_plot(
 /// everything without one.
 pub fn plot_fields(sim: &Simulation, dir: &Path) -> Result<Vec<PathBuf>, crate::run::RunError> {
     let window = sim.contact.as_ref().and_then(|c| c.bodies.first()).map(|b| {
-        let (lo, hi) = b.outline().iter().fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), v| (lo.min(v.x), hi.max(v.x)));
+        let (lo, hi) =
+            b.outline().iter().fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), v| (lo.min(v.x), hi.max(v.x)));
         let w = hi - lo;
         let cx = b.position.x + 0.5 * (lo + hi);
         [cx - 1.5 * w, cx + 1.5 * w, Real::NEG_INFINITY, Real::INFINITY]

@@ -194,10 +194,7 @@ impl Particles {
 
     /// Total linear momentum `Σ m_I V_I`.
     pub fn momentum(&self) -> Vec2 {
-        self.mass
-            .iter()
-            .zip(&self.v)
-            .fold(Vec2::zeros(), |acc, (m, v)| acc + v * *m)
+        self.mass.iter().zip(&self.v).fold(Vec2::zeros(), |acc, (m, v)| acc + v * *m)
     }
 }
 

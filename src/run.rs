@@ -3,9 +3,9 @@
 
 use crate::case::Case;
 use crate::checkpoint::{CheckpointError, RunProgress};
+use crate::contact::{ContactSystem, SlaveSet, SurfaceDetection};
 use crate::io::IoError;
 use crate::math::Real;
-use crate::contact::{ContactSystem, SlaveSet, SurfaceDetection};
 use crate::memory::{Footprint, MemoryError};
 use crate::model::{Model, ModelError};
 use crate::output::OutputWriter;
@@ -282,7 +282,11 @@ pub fn resume(cfg: &RunConfig, progress: &mut dyn FnMut(Progress)) -> Result<Run
     )?;
     append_resume_record(cfg, &path, sim.step)?;
     progress(Progress::Resumed { sim: &sim, checkpoint: &path, warnings: &warnings });
-    let schedule = Schedule { next_snapshot: saved.next_snapshot, next_checkpoint: saved.next_checkpoint, max_drift: saved.max_drift };
+    let schedule = Schedule {
+        next_snapshot: saved.next_snapshot,
+        next_checkpoint: saved.next_checkpoint,
+        max_drift: saved.max_drift,
+    };
     time_loop(&case, sim, out, schedule, true, cfg, t_setup, progress)
 }
 
@@ -320,7 +324,13 @@ struct Schedule {
 
 /// Write a checkpoint of the current state into the run's checkpoint
 /// directory (after the outputs of this step) and drop the oldest.
-fn save_checkpoint(case: &Case, sim: &Simulation, out: &OutputWriter, schedule: &Schedule, dir: &Path) -> Result<PathBuf, RunError> {
+fn save_checkpoint(
+    case: &Case,
+    sim: &Simulation,
+    out: &OutputWriter,
+    schedule: &Schedule,
+    dir: &Path,
+) -> Result<PathBuf, RunError> {
     out.sync()?;
     let progress = RunProgress {
         snapshot_times: out.snapshot_times(),
@@ -397,7 +407,12 @@ fn time_loop(
             last_checkpoint = Instant::now();
             progress(Progress::Checkpoint { sim: &sim, path: &path });
             if interrupted {
-                return Err(RunError::Interrupted { step: sim.step, time: sim.time, checkpoint: path, dir: cfg.out_dir.clone() });
+                return Err(RunError::Interrupted {
+                    step: sim.step,
+                    time: sim.time,
+                    checkpoint: path,
+                    dir: cfg.out_dir.clone(),
+                });
             }
         }
         let stepped = sim.step();

@@ -291,9 +291,11 @@ impl Simulation {
             return Ok(());
         };
         let (step, time) = (self.step + 1, self.time + dt);
-        let faces = cracks
-            .grow(&mut self.model, time, step)
-            .map_err(|source| SolverError::Fracture { source: Box::new(source), step, time })?;
+        let faces = cracks.grow(&mut self.model, time, step).map_err(|source| SolverError::Fracture {
+            source: Box::new(source),
+            step,
+            time,
+        })?;
         if faces.is_empty() {
             return Ok(());
         }
@@ -314,9 +316,11 @@ impl Simulation {
         let p = &self.model.particles;
         self.f_contact.resize(p.len(), Vec2::zeros());
         let input = StepInput::from_particles(p, Some(&self.model.particle_shape), dt);
-        contact
-            .compute_forces(&input, &mut self.f_contact)
-            .map_err(|source| SolverError::Contact { source, step: self.step + 1, time: self.time + dt })?;
+        contact.compute_forces(&input, &mut self.f_contact).map_err(|source| SolverError::Contact {
+            source,
+            step: self.step + 1,
+            time: self.time + dt,
+        })?;
         Ok(())
     }
 
@@ -325,9 +329,11 @@ impl Simulation {
         let Some(contact) = self.contact.as_mut() else {
             return Ok(());
         };
-        contact
-            .advance(&self.model.particles.v)
-            .map_err(|source| SolverError::Contact { source, step: self.step + 1, time: self.time + self.dt })?;
+        contact.advance(&self.model.particles.v).map_err(|source| SolverError::Contact {
+            source,
+            step: self.step + 1,
+            time: self.time + self.dt,
+        })?;
         let (mut wp, mut wb) = (0.0, 0.0);
         for b in 0..contact.bodies.len() {
             let s = contact.sample(b).expect("body exists");
@@ -346,7 +352,16 @@ impl Simulation {
         if self.f_contact.len() != p.len() {
             self.f_contact.resize(p.len(), Vec2::zeros());
         }
-        (p.v.par_iter_mut(), p.u.par_iter_mut(), p.a.par_iter_mut(), &p.f_int, &p.f_ext, &self.f_contact, &p.mass, &p.flags)
+        (
+            p.v.par_iter_mut(),
+            p.u.par_iter_mut(),
+            p.a.par_iter_mut(),
+            &p.f_int,
+            &p.f_ext,
+            &self.f_contact,
+            &p.mass,
+            &p.flags,
+        )
             .into_par_iter()
             .for_each(|(v, u, a, fi, fe, fc, m, flags)| {
                 let mut acc = (fe + fc - fi) / *m;
@@ -471,8 +486,11 @@ impl Simulation {
             return Ok(());
         }
         let span = std::mem::take(&mut self.heat_pending);
-        heat.conduct(&mut self.model, span)
-            .map_err(|source| SolverError::Heat { source, step: self.step + 1, time: self.time + dt })?;
+        heat.conduct(&mut self.model, span).map_err(|source| SolverError::Heat {
+            source,
+            step: self.step + 1,
+            time: self.time + dt,
+        })?;
         Ok(())
     }
 
@@ -513,7 +531,8 @@ impl Simulation {
         if let Some(q) = self.model.quad.tau.par_iter().position_first(|t: &Tensor3| !t.iter().all(|x| x.is_finite())) {
             return Err(SolverError::NonFinite { field: "stress", location: "quadrature point", index: q, step, time });
         }
-        if let Some(k) = (0..q.len()).into_par_iter().position_first(|k| scalars.iter().any(|(_, c)| !c[k].is_finite())) {
+        if let Some(k) = (0..q.len()).into_par_iter().position_first(|k| scalars.iter().any(|(_, c)| !c[k].is_finite()))
+        {
             let field = scalars.iter().find(|(_, c)| !c[k].is_finite()).map_or("state", |(f, _)| f);
             return Err(SolverError::NonFinite { field, location: "quadrature point", index: k, step, time });
         }
@@ -524,7 +543,13 @@ impl Simulation {
             return Err(SolverError::NonFinite { field: "internal force", location: "particle", index: i, step, time });
         }
         if let Some(i) = p.v.par_iter().position_first(|v| v.norm_squared() > bound2) {
-            return Err(SolverError::Runaway { particle: i, speed: p.v[i].norm(), bound: self.speed_bound, step, time });
+            return Err(SolverError::Runaway {
+                particle: i,
+                speed: p.v[i].norm(),
+                bound: self.speed_bound,
+                step,
+                time,
+            });
         }
         Ok(())
     }
@@ -559,7 +584,8 @@ impl Simulation {
         let (total, input) = (self.energies.total(), self.input_energy());
         if input > 0.0 && (total.is_nan() || total > ENERGY_BLOWUP_FACTOR * input) {
             let v = &self.model.particles.v;
-            let particle = (0..v.len()).fold(0, |best, i| if v[i].norm_squared() > v[best].norm_squared() { i } else { best });
+            let particle =
+                (0..v.len()).fold(0, |best, i| if v[i].norm_squared() > v[best].norm_squared() { i } else { best });
             let speed = v.get(particle).map_or(0.0, |v| v.norm());
             return Err(SolverError::EnergyBlowUp { total, input, particle, speed, step: self.step, time: self.time });
         }

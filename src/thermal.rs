@@ -93,7 +93,9 @@ pub enum HeatError {
     #[error("heat conduction safety factor must lie in (0, 1], got {0}")]
     InvalidSafetyFactor(Real),
     /// `F` cannot be inverted at a conducting quadrature point.
-    #[error("deformation gradient not invertible (J = {jacobian:.3e}) at quadrature point {point}: conduction needs F^-1")]
+    #[error(
+        "deformation gradient not invertible (J = {jacobian:.3e}) at quadrature point {point}: conduction needs F^-1"
+    )]
     Inverted { point: usize, jacobian: Real },
     /// A temperature became NaN or infinite.
     #[error("non-finite temperature at quadrature point {point} after conduction")]
@@ -165,46 +167,27 @@ impl HeatConduction {
         }
         let mut bodies = Vec::with_capacity(model.materials.len());
         for (b, m) in model.materials.iter().enumerate() {
-            let name = || {
-                model
-                    .bodies
-                    .get(b)
-                    .map_or_else(|| format!("#{b}"), |i| i.name.clone())
-            };
+            let name = || model.bodies.get(b).map_or_else(|| format!("#{b}"), |i| i.name.clone());
             bodies.push(match m.thermal() {
                 None => None,
                 Some(t) => {
                     if !(t.specific_heat.is_finite() && t.specific_heat > 0.0) {
                         return Err(HeatError::InvalidMaterial {
                             body: name(),
-                            message: format!(
-                                "specific heat must be > 0 J/(kg K), got {}",
-                                t.specific_heat
-                            ),
+                            message: format!("specific heat must be > 0 J/(kg K), got {}", t.specific_heat),
                         });
                     }
                     if !(t.conductivity.is_finite() && t.conductivity >= 0.0) {
                         return Err(HeatError::InvalidMaterial {
                             body: name(),
-                            message: format!(
-                                "conductivity must be >= 0 W/(m K), got {}",
-                                t.conductivity
-                            ),
+                            message: format!("conductivity must be >= 0 W/(m K), got {}", t.conductivity),
                         });
                     }
-                    Some(BodyThermal {
-                        specific_heat: t.specific_heat,
-                        conductivity: t.conductivity,
-                    })
+                    Some(BodyThermal { specific_heat: t.specific_heat, conductivity: t.conductivity })
                 }
             });
         }
-        Ok(HeatConduction {
-            bodies,
-            safety_factor,
-            last: HeatReport::default(),
-            scratch: Scratch::default(),
-        })
+        Ok(HeatConduction { bodies, safety_factor, last: HeatReport::default(), scratch: Scratch::default() })
     }
 
     /// Whether any body conducts.
@@ -232,16 +215,8 @@ impl HeatConduction {
         self.prepare(model)?;
         self.project(model);
         let stable_dt = self.stable_step_from_prepared(model);
-        let substeps = if dt > 0.0 {
-            (dt / stable_dt).ceil().max(1.0) as usize
-        } else {
-            0
-        };
-        let sub_dt = if substeps > 0 {
-            dt / substeps as Real
-        } else {
-            0.0
-        };
+        let substeps = if dt > 0.0 { (dt / stable_dt).ceil().max(1.0) as usize } else { 0 };
+        let sub_dt = if substeps > 0 { dt / substeps as Real } else { 0.0 };
         for k in 0..substeps {
             if k > 0 {
                 self.flux_pass(model, false);
@@ -250,10 +225,7 @@ impl HeatConduction {
             self.advance(model, sub_dt);
         }
         self.interpolate_back(model)?;
-        self.last = HeatReport {
-            substeps,
-            stable_dt,
-        };
+        self.last = HeatReport { substeps, stable_dt };
         Ok(self.last)
     }
 
@@ -285,12 +257,7 @@ impl HeatConduction {
     fn stable_step_from_prepared(&mut self, model: &Model) -> Real {
         self.flux_pass(model, true);
         self.gather_pass(model, true);
-        let lambda = self
-            .scratch
-            .bound
-            .par_iter()
-            .cloned()
-            .reduce(|| 0.0, Real::max);
+        let lambda = self.scratch.bound.par_iter().cloned().reduce(|| 0.0, Real::max);
         if lambda > 0.0 {
             self.safety_factor * 2.0 / lambda
         } else {
@@ -335,19 +302,10 @@ impl HeatConduction {
     /// Particle temperatures of conducting bodies: capacity-weighted lumped
     /// projection of the quadrature temperatures; remember them as the start.
     fn project(&mut self, model: &mut Model) {
-        let (tab, gather, tq, wq) = (
-            &model.qp_shape,
-            &model.gather,
-            &model.quad.temperature,
-            &model.quad.weight,
-        );
+        let (tab, gather, tq, wq) = (&model.qp_shape, &model.gather, &model.quad.temperature, &model.quad.weight);
         let bodies = &self.bodies;
         let p = &mut model.particles;
-        (
-            p.temperature.par_iter_mut(),
-            self.scratch.start.par_iter_mut(),
-            &p.body,
-        )
+        (p.temperature.par_iter_mut(), self.scratch.start.par_iter_mut(), &p.body)
             .into_par_iter()
             .enumerate()
             .for_each(|(i, (t, start, b))| {
@@ -373,10 +331,8 @@ impl HeatConduction {
     fn flux_pass(&mut self, model: &Model, with_bound: bool) {
         let (tab, temp) = (&model.qp_shape, &model.particles.temperature);
         let s = &mut self.scratch;
-        (s.flux.par_iter_mut(), s.row_norm.par_iter_mut(), &s.kw)
-            .into_par_iter()
-            .enumerate()
-            .for_each(|(q, (flux, norm, kw))| {
+        (s.flux.par_iter_mut(), s.row_norm.par_iter_mut(), &s.kw).into_par_iter().enumerate().for_each(
+            |(q, (flux, norm, kw))| {
                 if *kw == Matrix2::zeros() {
                     *flux = Vec2::zeros();
                     *norm = 0.0;
@@ -395,7 +351,8 @@ impl HeatConduction {
                 if with_bound {
                     *norm = n;
                 }
-            });
+            },
+        );
     }
 
     /// Per particle: `−(H T)_I / c_I = Σ_q ∇N_I · (q_q w_q) / c_I`, gathered
@@ -406,15 +363,8 @@ impl HeatConduction {
         let bodies = &self.bodies;
         let s = &mut self.scratch;
         let (flux, kw, row_norm) = (&s.flux, &s.kw, &s.row_norm);
-        (
-            s.rate.par_iter_mut(),
-            s.bound.par_iter_mut(),
-            &p.body,
-            &p.mass,
-        )
-            .into_par_iter()
-            .enumerate()
-            .for_each(|(i, (rate, bound, b, m))| {
+        (s.rate.par_iter_mut(), s.bound.par_iter_mut(), &p.body, &p.mass).into_par_iter().enumerate().for_each(
+            |(i, (rate, bound, b, m))| {
                 let Some(t) = bodies.get(*b as usize).and_then(|t| t.as_ref()) else {
                     *rate = 0.0;
                     *bound = 0.0;
@@ -434,7 +384,8 @@ impl HeatConduction {
                 if with_bound {
                     *bound = bnd / c;
                 }
-            });
+            },
+        );
     }
 
     /// One explicit Euler sub-step on the particles of conducting bodies.
@@ -442,20 +393,14 @@ impl HeatConduction {
         let bodies = &self.bodies;
         let s = &mut self.scratch;
         let p = &mut model.particles;
-        (
-            p.temperature.par_iter_mut(),
-            s.delta.par_iter_mut(),
-            &s.start,
-            &s.rate,
-            &p.body,
-        )
-            .into_par_iter()
-            .for_each(|(t, d, start, rate, b)| {
+        (p.temperature.par_iter_mut(), s.delta.par_iter_mut(), &s.start, &s.rate, &p.body).into_par_iter().for_each(
+            |(t, d, start, rate, b)| {
                 if conducts(bodies, *b) {
                     *d += sub_dt * rate;
                     *t = start + *d;
                 }
-            });
+            },
+        );
     }
 
     /// `T_q ← T_q + Σ_I N_I(X_q) ΔT_I` at conducting points; NaN check.
@@ -546,26 +491,15 @@ mod tests {
             youngs_modulus: 1e9,
             poisson_ratio: 0.3,
             room_temperature: 300.0,
-            thermal: Some(ThermalProperties {
-                specific_heat: 500.0,
-                conductivity: kappa,
-            }),
+            thermal: Some(ThermalProperties { specific_heat: 500.0, conductivity: kappa }),
         });
-        let b = BodySetup {
-            name: "b".into(),
-            grid: g,
-            material: m,
-            initial_velocity: vec![],
-            supports: vec![],
-        };
+        let b = BodySetup { name: "b".into(), grid: g, material: m, initial_velocity: vec![], supports: vec![] };
         Model::build(mode, &[b]).unwrap()
     }
 
     /// Deterministic pseudo-random numbers in [0, 1).
     fn lcg(s: &mut u64) -> Real {
-        *s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
+        *s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         (*s >> 11) as Real / (1u64 << 53) as Real
     }
 
@@ -597,10 +531,7 @@ mod tests {
         let mut v: Vec<Real> = (0..n).map(|_| lcg(&mut s) - 0.5).collect();
         let mut lambda = 0.0;
         for _ in 0..3000 {
-            let w: Vec<Real> = a
-                .iter()
-                .map(|row| row.iter().zip(&v).map(|(x, y)| x * y).sum())
-                .collect();
+            let w: Vec<Real> = a.iter().map(|row| row.iter().zip(&v).map(|(x, y)| x * y).sum()).collect();
             let norm = w.iter().map(|x| x * x).sum::<Real>().sqrt();
             lambda = norm / v.iter().map(|x| x * x).sum::<Real>().sqrt();
             v = w.iter().map(|x| x / norm).collect();
@@ -615,16 +546,12 @@ mod tests {
         let mut c = vec![0.0; m.particles.len()];
         for q in 0..m.quad.len() {
             for k in m.qp_shape.range(q) {
-                c[m.qp_shape.index[k] as usize] +=
-                    2000.0 * 500.0 * m.qp_shape.value[k] * m.quad.weight[q];
+                c[m.qp_shape.index[k] as usize] += 2000.0 * 500.0 * m.qp_shape.value[k] * m.quad.weight[q];
             }
         }
         for (i, ci) in c.iter().enumerate() {
             let got = heat.capacity(&m, i).unwrap();
-            assert!(
-                (got - ci).abs() <= 1e-12 * ci.abs(),
-                "particle {i}: {got} vs {ci}"
-            );
+            assert!((got - ci).abs() <= 1e-12 * ci.abs(), "particle {i}: {got} vs {ci}");
         }
     }
 
@@ -635,9 +562,7 @@ mod tests {
         let mut f = Tensor3::identity();
         f[(0, 0)] = 2.0;
         let k = reference_conductivity(&f, 3.0).unwrap();
-        assert!(
-            (k[(0, 0)] - 1.5).abs() < 1e-15 && (k[(1, 1)] - 6.0).abs() < 1e-15 && k[(0, 1)] == 0.0
-        );
+        assert!((k[(0, 0)] - 1.5).abs() < 1e-15 && (k[(1, 1)] - 6.0).abs() < 1e-15 && k[(0, 1)] == 0.0);
         // a hoop stretch in axisymmetry widens the faces in both in-plane directions
         let mut f = Tensor3::identity();
         f[(2, 2)] = 1.5;
@@ -678,14 +603,8 @@ mod tests {
             let dt = heat.stable_time_step(&mut m).unwrap();
             let bound = 2.0 / dt;
             let lambda = largest_eigenvalue(&dense_operator(&m, &heat));
-            assert!(
-                bound >= lambda,
-                "case {n}: bound {bound:.4e} below lambda_max {lambda:.4e}"
-            );
-            assert!(
-                bound < 5.0 * lambda,
-                "case {n}: bound {bound:.4e} too pessimistic vs {lambda:.4e}"
-            );
+            assert!(bound >= lambda, "case {n}: bound {bound:.4e} below lambda_max {lambda:.4e}");
+            assert!(bound < 5.0 * lambda, "case {n}: bound {bound:.4e} too pessimistic vs {lambda:.4e}");
         }
     }
 
@@ -716,23 +635,11 @@ mod tests {
         let mut heat = HeatConduction::new(&m, 0.5).unwrap();
         assert!(!heat.is_active());
         heat.conduct(&mut m, 1e-3).unwrap();
-        assert_eq!(
-            (m.quad.temperature.clone(), m.particles.temperature.clone()),
-            before
-        );
+        assert_eq!((m.quad.temperature.clone(), m.particles.temperature.clone()), before);
         if let Material::Elastic(e) = &mut m.materials[0] {
-            e.thermal = Some(ThermalProperties {
-                specific_heat: 0.0,
-                conductivity: 1.0,
-            });
+            e.thermal = Some(ThermalProperties { specific_heat: 0.0, conductivity: 1.0 });
         }
-        assert!(matches!(
-            HeatConduction::new(&m, 0.5),
-            Err(HeatError::InvalidMaterial { .. })
-        ));
-        assert!(matches!(
-            HeatConduction::new(&m, 1.5),
-            Err(HeatError::InvalidSafetyFactor(_))
-        ));
+        assert!(matches!(HeatConduction::new(&m, 0.5), Err(HeatError::InvalidMaterial { .. })));
+        assert!(matches!(HeatConduction::new(&m, 1.5), Err(HeatError::InvalidSafetyFactor(_))));
     }
 }

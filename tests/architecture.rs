@@ -26,7 +26,18 @@ fn architecture_map_names_existing_paths_and_all_modules() {
 #[test]
 fn physics_modules_do_not_import_the_driver_layer() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let physics = ["math.rs", "particles.rs", "quadrature.rs", "geometry.rs", "neighbors.rs", "kernel.rs", "shape", "material", "discretize.rs", "thermal.rs"];
+    let physics = [
+        "math.rs",
+        "particles.rs",
+        "quadrature.rs",
+        "geometry.rs",
+        "neighbors.rs",
+        "kernel.rs",
+        "shape",
+        "material",
+        "discretize.rs",
+        "thermal.rs",
+    ];
     let upper = ["crate::step", "crate::case", "crate::run", "crate::output", "crate::cases"];
     let mut files = Vec::new();
     for p in physics {

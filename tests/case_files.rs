@@ -99,7 +99,8 @@ fn malformed_toml_rejected() {
 
 #[test]
 fn overrides_apply_and_are_validated() {
-    let c = Case::from_str_with(GOOD, "good.toml", &["time.end=2e-5".into(), "bodies.plate.rectangle.layers=8".into()]).unwrap();
+    let c = Case::from_str_with(GOOD, "good.toml", &["time.end=2e-5".into(), "bodies.plate.rectangle.layers=8".into()])
+        .unwrap();
     assert_eq!(c.time.end, 2e-5);
     assert_eq!(c.bodies[0].rectangle.layers, 8);
     let c = Case::from_str_with(GOOD, "good.toml", &["bodies.0.material=steel".into()]).unwrap();

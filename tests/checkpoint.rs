@@ -28,10 +28,7 @@ fn case(text: &str, overrides: &[&str]) -> Case {
 }
 
 fn config(dir: &Path, interrupt: Option<Arc<AtomicBool>>) -> RunConfig {
-    RunConfig {
-        interrupt,
-        ..RunConfig::new(dir.to_path_buf(), true, RunInfo::current("test", &[]))
-    }
+    RunConfig { interrupt, ..RunConfig::new(dir.to_path_buf(), true, RunInfo::current("test", &[])) }
 }
 
 /// Run to the end; the final state.
@@ -59,15 +56,8 @@ fn run_until(case: &Case, dir: &Path, step: u64) -> PathBuf {
     })
     .expect_err("an interrupted run returns an error");
     match err {
-        RunError::Interrupted {
-            step: s,
-            checkpoint,
-            ..
-        } => {
-            assert_eq!(
-                s, step,
-                "the checkpoint is taken at the end of the step during which the interrupt came"
-            );
+        RunError::Interrupted { step: s, checkpoint, .. } => {
+            assert_eq!(s, step, "the checkpoint is taken at the end of the step during which the interrupt came");
             assert!(err_text(&checkpoint).is_empty());
             checkpoint
         }
@@ -106,18 +96,12 @@ fn assert_same_state(a: &Simulation, b: &Simulation, case: &Case) {
         next_checkpoint: 0.0,
         max_drift: 0.0,
     };
-    assert_eq!(
-        (a.step, a.time.to_bits(), a.dt.to_bits()),
-        (b.step, b.time.to_bits(), b.dt.to_bits())
-    );
+    assert_eq!((a.step, a.time.to_bits(), a.dt.to_bits()), (b.step, b.time.to_bits(), b.dt.to_bits()));
     assert!(
         checkpoint::state_bytes(a, case, &progress) == checkpoint::state_bytes(b, case, &progress),
         "the encoded states differ"
     );
-    assert_eq!(
-        format!("{:?}", a.model.particles),
-        format!("{:?}", b.model.particles)
-    );
+    assert_eq!(format!("{:?}", a.model.particles), format!("{:?}", b.model.particles));
     assert_eq!(format!("{:?}", a.model.quad), format!("{:?}", b.model.quad));
     assert_eq!(format!("{:?}", a.energies), format!("{:?}", b.energies));
     assert_eq!(format!("{:?}", a.contact), format!("{:?}", b.contact));
@@ -127,10 +111,7 @@ fn assert_same_state(a: &Simulation, b: &Simulation, case: &Case) {
     let (mut a, mut b) = (a.clone(), b.clone());
     a.timers = Default::default();
     b.timers = Default::default();
-    assert!(
-        format!("{a:?}") == format!("{b:?}"),
-        "the simulations differ in a field the checkpoint does not carry"
-    );
+    assert!(format!("{a:?}") == format!("{b:?}"), "the simulations differ in a field the checkpoint does not carry");
 }
 
 /// The files a run leaves, except the ones that record how it ran
@@ -156,10 +137,7 @@ fn assert_same_outputs(reference: &Path, resumed: &Path) {
     let names = |f: &[(String, Vec<u8>)]| f.iter().map(|(n, _)| n.clone()).collect::<Vec<_>>();
     assert_eq!(names(&a), names(&b), "the same files");
     for ((name, x), (_, y)) in a.iter().zip(&b) {
-        assert!(
-            x == y,
-            "{name} differs between the uninterrupted and the resumed run"
-        );
+        assert!(x == y, "{name} differs between the uninterrupted and the resumed run");
     }
 }
 
@@ -177,39 +155,24 @@ fn kill_and_resume(name: &str, case: &Case, stop_at: u64) -> (Simulation, Simula
     // the resume must drop and write again.
     std::fs::remove_file(&at_stop).unwrap();
     let ckpts = checkpoint::list(&checkpoint::directory(&dir));
-    let (from_step, from) = ckpts
-        .last()
-        .cloned()
-        .expect("a periodic checkpoint before the stop");
-    assert!(
-        from_step < stop_at && from_step > 0,
-        "checkpoint at step {from_step}, stop at {stop_at}"
-    );
+    let (from_step, from) = ckpts.last().cloned().expect("a periodic checkpoint before the stop");
+    assert!(from_step < stop_at && from_step > 0, "checkpoint at step {from_step}, stop at {stop_at}");
     std::fs::write(dir.join("particles_00999.vtu"), b"stale").unwrap();
     std::fs::write(dir.join("cracks_00999.vtu"), b"stale").unwrap();
-    let rows_before = std::fs::read_to_string(dir.join("history.csv"))
-        .unwrap()
-        .lines()
-        .count();
+    let rows_before = std::fs::read_to_string(dir.join("history.csv")).unwrap().lines().count();
     let resumed_from = checkpoint::read(&from).unwrap().sim;
 
     let (resumed, warnings) = resume_to_end(&dir);
     assert!(warnings.is_empty(), "{warnings:?}");
     assert_same_state(&full, &resumed, case);
     assert_same_outputs(&reference, &dir);
-    assert!(
-        !dir.join("particles_00999.vtu").exists(),
-        "snapshots after the checkpoint are removed"
-    );
+    assert!(!dir.join("particles_00999.vtu").exists(), "snapshots after the checkpoint are removed");
     assert!(!dir.join("cracks_00999.vtu").exists());
     let history = std::fs::read_to_string(dir.join("history.csv")).unwrap();
     assert!(history.lines().count() > rows_before, "history continued");
     let info = std::fs::read_to_string(dir.join("run_info.toml")).unwrap();
     let info: toml::Table = toml::from_str(&info).expect("run_info.toml stays valid TOML");
-    assert_eq!(
-        info["resumed"].as_array().unwrap()[0]["step"].as_integer(),
-        Some(from_step as i64)
-    );
+    assert_eq!(info["resumed"].as_array().unwrap()[0]["step"].as_integer(), Some(from_step as i64));
     (resumed_from, resumed)
 }
 
@@ -249,18 +212,9 @@ fn resumed_contact_run_is_bit_identical_to_an_uninterrupted_one() {
     let (from, _) = kill_and_resume("contact", &case, 20);
     // The contact must be active across the checkpoint for the test to mean anything.
     let c = from.contact.as_ref().unwrap();
-    assert!(
-        c.bodies[0].velocity.y > -298.0 + 1.0,
-        "the projectile was slowed by contact"
-    );
-    assert!(
-        c.sample(0).unwrap().active_contacts > 0,
-        "contacts at the checkpoint"
-    );
-    assert!(
-        (0..c.slaves.len()).any(|k| c.slaves.pairing(k).is_some()),
-        "slaves are paired"
-    );
+    assert!(c.bodies[0].velocity.y > -298.0 + 1.0, "the projectile was slowed by contact");
+    assert!(c.sample(0).unwrap().active_contacts > 0, "contacts at the checkpoint");
+    assert!((0..c.slaves.len()).any(|k| c.slaves.pairing(k).is_some()), "slaves are paired");
 }
 
 /// Crack growth across the checkpoint: a crack nucleated before it grows
@@ -271,31 +225,19 @@ fn resumed_contact_run_is_bit_identical_to_an_uninterrupted_one() {
 fn resumed_fracture_run_is_bit_identical_to_an_uninterrupted_one() {
     let case = case(BORVIK_FRACTURE, FRACTURE_SETS);
     let (from, end) = kill_and_resume("fracture", &case, FRACTURE_STOP);
-    assert!(
-        case.heat_conduction(),
-        "conduction is on across the checkpoint"
-    );
+    assert!(case.heat_conduction(), "conduction is on across the checkpoint");
     assert!(from.heat_pending > 0.0, "heat is pending at the checkpoint");
     let at = from.cracks.as_ref().expect("fracture is on");
     let final_events = &end.cracks.as_ref().unwrap().events;
-    assert!(
-        !at.cracks.is_empty(),
-        "a crack nucleated before the checkpoint"
-    );
+    assert!(!at.cracks.is_empty(), "a crack nucleated before the checkpoint");
     assert!(
         final_events.len() > at.events.len()
-            && final_events[at.events.len()..]
-                .iter()
-                .any(|e| e.crack < at.cracks.len()),
+            && final_events[at.events.len()..].iter().any(|e| e.crack < at.cracks.len()),
         "a crack of the checkpoint grew after it"
     );
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("checkpoint-fracture-resumed");
     let log = std::fs::read_to_string(dir.join("cracks.csv")).unwrap();
-    assert_eq!(
-        log.lines().count(),
-        1 + final_events.len(),
-        "one row per event"
-    );
+    assert_eq!(log.lines().count(), 1 + final_events.len(), "one row per event");
     let pvd = std::fs::read_to_string(dir.join("results.pvd")).unwrap();
     assert_eq!(
         pvd.matches("part=\"1\"").count(),
@@ -334,11 +276,7 @@ fn crack_state_round_trips_bit_for_bit() {
     let mut restored = checkpoint::read(&path).unwrap();
     let cracks = restored.sim.cracks.as_mut().expect("fracture is on");
     assert!(cracks.cracks.is_empty(), "no crack yet at step 2");
-    let odd = [
-        f64::from_bits(0x7ff8_dead_beef_0001),
-        -0.0,
-        f64::NEG_INFINITY,
-    ];
+    let odd = [f64::from_bits(0x7ff8_dead_beef_0001), -0.0, f64::NEG_INFINITY];
     for (k, value) in odd.into_iter().enumerate() {
         cracks.events.push(plugsim::fracture::CrackEvent {
             time: -0.0,
@@ -353,14 +291,8 @@ fn crack_state_round_trips_bit_for_bit() {
     cracks.cracks.push(plugsim::fracture::Crack {
         id: 0,
         vertices: vec![
-            plugsim::fracture::CrackVertex {
-                x0: restored.sim.model.particles.x0[0],
-                faces: None,
-            },
-            plugsim::fracture::CrackVertex {
-                x0: restored.sim.model.particles.x0[1],
-                faces: Some((0, 1)),
-            },
+            plugsim::fracture::CrackVertex { x0: restored.sim.model.particles.x0[0], faces: None },
+            plugsim::fracture::CrackVertex { x0: restored.sim.model.particles.x0[1], faces: Some((0, 1)) },
         ],
         tip: Some(1),
         offset: 1e-6,
@@ -371,18 +303,9 @@ fn crack_state_round_trips_bit_for_bit() {
     checkpoint::write(&again, &restored.sim, &restored.case, &restored.progress).unwrap();
     let back = checkpoint::read(&again).unwrap();
     let bytes = |s: &Simulation| checkpoint::state_bytes(s, &restored.case, &restored.progress);
-    assert!(
-        bytes(&back.sim) == bytes(&restored.sim),
-        "state bytes differ after a round trip"
-    );
+    assert!(bytes(&back.sim) == bytes(&restored.sim), "state bytes differ after a round trip");
     let bits = |s: &Simulation| {
-        s.cracks
-            .as_ref()
-            .unwrap()
-            .events
-            .iter()
-            .map(|e| (e.time.to_bits(), e.value.to_bits()))
-            .collect::<Vec<_>>()
+        s.cracks.as_ref().unwrap().events.iter().map(|e| (e.time.to_bits(), e.value.to_bits())).collect::<Vec<_>>()
     };
     assert_eq!(bits(&back.sim), bits(&restored.sim));
 }
@@ -396,10 +319,7 @@ fn checkpoint_round_trips_the_state_exactly() {
     let again = dir.join("again.ckpt");
     let progress = restored.progress.clone();
     checkpoint::write(&again, &restored.sim, &restored.case, &progress).unwrap();
-    assert!(
-        std::fs::read(&path).unwrap() == std::fs::read(&again).unwrap(),
-        "write(read(file)) == file"
-    );
+    assert!(std::fs::read(&path).unwrap() == std::fs::read(&again).unwrap(), "write(read(file)) == file");
     assert_eq!(restored.sim.step, 5);
     assert_eq!(restored.writer, checkpoint::this_writer());
 }
@@ -417,18 +337,12 @@ fn checkpoint_of_another_format_version_is_refused_naming_both() {
     let path = run_until(&case, &dir, 3);
     for old in [0u32, FORMAT_VERSION + 1] {
         corrupt(&path, 8, &old.to_le_bytes());
-        let e = resume(&config(&dir, None), &mut |_| {})
-            .unwrap_err()
-            .to_string();
+        let e = resume(&config(&dir, None), &mut |_| {}).unwrap_err().to_string();
         assert!(
-            e.contains(&format!("format version {old}"))
-                && e.contains(&format!("format version {FORMAT_VERSION}")),
+            e.contains(&format!("format version {old}")) && e.contains(&format!("format version {FORMAT_VERSION}")),
             "{e}"
         );
-        assert!(
-            e.contains(&path.display().to_string()) && e.contains("plugsim 0."),
-            "{e}"
-        );
+        assert!(e.contains(&path.display().to_string()) && e.contains("plugsim 0."), "{e}");
     }
 }
 
@@ -442,17 +356,9 @@ fn version_1_checkpoint_is_refused_naming_both_versions() {
     let path = run_until(&case, &dir, 2);
     corrupt(&path, 8, &1u32.to_le_bytes());
     let e = checkpoint::read(&path).unwrap_err().to_string();
-    assert!(
-        e.contains("format version 1 ") && e.contains("reads format version 2"),
-        "{e}"
-    );
-    let e = resume(&config(&dir, None), &mut |_| {})
-        .unwrap_err()
-        .to_string();
-    assert!(
-        e.contains("format version 1 ") && e.contains("format version 2"),
-        "{e}"
-    );
+    assert!(e.contains("format version 1 ") && e.contains("reads format version 2"), "{e}");
+    let e = resume(&config(&dir, None), &mut |_| {}).unwrap_err().to_string();
+    assert!(e.contains("format version 1 ") && e.contains("format version 2"), "{e}");
 }
 
 #[test]
@@ -469,10 +375,7 @@ fn damaged_checkpoints_are_refused_or_skipped_for_an_older_one() {
     assert!(e.contains("damaged") && e.contains("checksum"), "{e}");
     // resume falls back to the older checkpoint and says so
     let (_, warnings) = resume_to_end(&dir);
-    assert!(
-        warnings.iter().any(|w| w.contains("damaged")),
-        "{warnings:?}"
-    );
+    assert!(warnings.iter().any(|w| w.contains("damaged")), "{warnings:?}");
 
     // truncated, and not a checkpoint at all
     let dir = scratch("truncated");
@@ -484,9 +387,7 @@ fn damaged_checkpoints_are_refused_or_skipped_for_an_older_one() {
     std::fs::write(&path, b"hello").unwrap();
     let e = checkpoint::read(&path).unwrap_err().to_string();
     assert!(e.contains("not a plugsim checkpoint"), "{e}");
-    let e = resume(&config(&scratch("none"), None), &mut |_| {})
-        .unwrap_err()
-        .to_string();
+    let e = resume(&config(&scratch("none"), None), &mut |_| {}).unwrap_err().to_string();
     assert!(e.contains("no checkpoint"), "{e}");
 }
 
@@ -500,15 +401,11 @@ fn a_fresh_run_removes_the_checkpoints_of_an_earlier_run_in_its_directory() {
 }
 
 fn plugsim(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_plugsim"))
-        .args(args)
-        .output()
-        .unwrap()
+    Command::new(env!("CARGO_BIN_EXE_plugsim")).args(args).output().unwrap()
 }
 
 fn history_rows(dir: &Path) -> usize {
-    std::fs::read_to_string(dir.join("history.csv"))
-        .map_or(0, |t| t.lines().count().saturating_sub(1))
+    std::fs::read_to_string(dir.join("history.csv")).map_or(0, |t| t.lines().count().saturating_sub(1))
 }
 
 /// The real thing: the binary, stopped by SIGTERM (checkpoint, exit 130,
@@ -540,11 +437,7 @@ fn binary_survives_sigterm_and_sigkill() {
     let reference = scratch("binary-reference");
     let a = args(&reference);
     let out = plugsim(&a.iter().map(String::as_str).collect::<Vec<_>>());
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
 
     for signal in ["TERM", "KILL"] {
         let dir = scratch(&format!("binary-{signal}"));
@@ -556,29 +449,17 @@ fn binary_survives_sigterm_and_sigkill() {
             .unwrap();
         let started = std::time::Instant::now();
         while checkpoint::list(&checkpoint::directory(&dir)).is_empty() || history_rows(&dir) < 30 {
-            assert!(
-                started.elapsed().as_secs() < 60,
-                "the run wrote no checkpoint"
-            );
+            assert!(started.elapsed().as_secs() < 60, "the run wrote no checkpoint");
             std::thread::sleep(std::time::Duration::from_millis(5));
         }
-        let status = Command::new("kill")
-            .args([&format!("-{signal}"), &child.id().to_string()])
-            .status()
-            .unwrap();
+        let status = Command::new("kill").args([&format!("-{signal}"), &child.id().to_string()]).status().unwrap();
         assert!(status.success());
         let out = child.wait_with_output().unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
-        assert!(
-            !out.status.success(),
-            "a stopped run must not exit 0 ({signal}): {stderr}"
-        );
+        assert!(!out.status.success(), "a stopped run must not exit 0 ({signal}): {stderr}");
         if signal == "TERM" {
             assert_eq!(out.status.code(), Some(130), "{stderr}");
-            assert!(
-                stderr.contains("plugsim resume") && stderr.contains("interrupted at step"),
-                "{stderr}"
-            );
+            assert!(stderr.contains("plugsim resume") && stderr.contains("interrupted at step"), "{stderr}");
         }
         let out = plugsim(&["resume", &dir.display().to_string()]);
         let stderr = String::from_utf8_lossy(&out.stderr);
@@ -596,24 +477,12 @@ fn altered_checkpoints_never_panic_the_reader() {
     use proptest::prelude::*;
     use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
     let dir = scratch("fuzz");
-    let path = run_until(
-        &case(
-            STRIKE,
-            &["time.end=1e-6", "bodies.plate.rectangle.layers=4"],
-        ),
-        &dir,
-        2,
-    );
+    let path = run_until(&case(STRIKE, &["time.end=1e-6", "bodies.plate.rectangle.layers=4"]), &dir, 2);
     let original = std::fs::read(&path).unwrap();
     let writer_len = u32::from_le_bytes(original[12..16].try_into().unwrap()) as usize;
     let payload_at = 16 + writer_len + 12;
-    let config = Config {
-        cases: 200,
-        failure_persistence: None,
-        ..Config::default()
-    };
-    let mut runner =
-        TestRunner::new_with_rng(config, TestRng::deterministic_rng(RngAlgorithm::ChaCha));
+    let config = Config { cases: 200, failure_persistence: None, ..Config::default() };
+    let mut runner = TestRunner::new_with_rng(config, TestRng::deterministic_rng(RngAlgorithm::ChaCha));
     let edits = prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..6);
     let target = dir.join("altered.ckpt");
     runner

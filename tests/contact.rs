@@ -19,11 +19,7 @@ use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 
 const STEEL_DENSITY: Real = 7850.0;
-const MODES: [Spreading; 3] = [
-    Spreading::None,
-    Spreading::InverseDistance,
-    Spreading::ShapeFunction,
-];
+const MODES: [Spreading; 3] = [Spreading::None, Spreading::InverseDistance, Spreading::ShapeFunction];
 
 // ---------------------------------------------------------------- helpers
 
@@ -41,10 +37,7 @@ fn splitmix(state: &mut u64) -> Real {
 /// cubic B-spline window, gradients through `M⁻¹`) of `nodes` at `points`,
 /// by an O(n·m) loop.
 fn rk_table(nodes: &[Vec2], volume: &[Real], support: &[Real], points: &[Vec2]) -> ShapeTable {
-    let mut t = ShapeTable {
-        offsets: vec![0],
-        ..ShapeTable::default()
-    };
+    let mut t = ShapeTable { offsets: vec![0], ..ShapeTable::default() };
     for x in points {
         let mut m = Matrix4::<Real>::zeros();
         let mut dm = [Matrix4::<Real>::zeros(); 2];
@@ -56,15 +49,12 @@ fn rk_table(nodes: &[Vec2], volume: &[Real], support: &[Real], points: &[Vec2]) 
                 continue;
             }
             let p = Vector4::new(1.0, z.x, z.y, z.x * z.y);
-            let dp = [
-                Vector4::new(0.0, 1.0, 0.0, z.y),
-                Vector4::new(0.0, 0.0, 1.0, z.x),
-            ];
+            let dp = [Vector4::new(0.0, 1.0, 0.0, z.y), Vector4::new(0.0, 0.0, 1.0, z.x)];
             let w = phi * volume[i];
             m += p * p.transpose() * w;
             for k in 0..2 {
-                dm[k] += (dp[k] * p.transpose() + p * dp[k].transpose()) * w
-                    + p * p.transpose() * (dphi[k] * volume[i]);
+                dm[k] +=
+                    (dp[k] * p.transpose() + p * dp[k].transpose()) * w + p * p.transpose() * (dphi[k] * volume[i]);
             }
             near.push((i, p, dp, phi, dphi));
         }
@@ -118,15 +108,7 @@ fn lattice(xs: &[Real], ys: &[Real]) -> Particles {
     for (j, y) in ys.iter().enumerate() {
         for (i, x) in xs.iter().enumerate() {
             let h = gx[i].max(gy[j]);
-            let k = p.push(
-                Vec2::new(*x, *y),
-                wx[i] * wy[j],
-                h,
-                2.0 * h,
-                293.0,
-                0,
-                ParticleFlags::default(),
-            );
+            let k = p.push(Vec2::new(*x, *y), wx[i] * wy[j], h, 2.0 * h, 293.0, 0, ParticleFlags::default());
             p.mass[k] = STEEL_DENSITY * p.volume[k];
         }
     }
@@ -153,9 +135,7 @@ fn step(
     f_c: &mut Vec<Vec2>,
 ) -> StepReport {
     f_c.resize(p.len(), Vec2::zeros());
-    let report = sys
-        .compute_forces(&StepInput::from_particles(p, shape, dt), f_c)
-        .unwrap();
+    let report = sys.compute_forces(&StepInput::from_particles(p, shape, dt), f_c).unwrap();
     for i in 0..p.len() {
         let a = (p.f_ext[i] + f_c[i] - p.f_int[i]) / p.mass[i];
         p.v[i] += a * dt;
@@ -176,21 +156,13 @@ fn single_particle(x0: Vec2, mass: Real) -> Particles {
 
 /// A wide static wall whose top face (segment 2, normal +y) is at `y = top`.
 fn wall(top: Real) -> RigidBody {
-    RigidBody::new(
-        "wall",
-        rectangle_outline(1.0, 0.2),
-        Vec2::new(0.0, top - 0.1),
-        Vec2::zeros(),
-        1.0,
-    )
-    .unwrap()
-    .with_prescribed_velocity(Vec2::zeros())
+    RigidBody::new("wall", rectangle_outline(1.0, 0.2), Vec2::new(0.0, top - 0.1), Vec2::zeros(), 1.0)
+        .unwrap()
+        .with_prescribed_velocity(Vec2::zeros())
 }
 
 fn kinetic(p: &Particles) -> Real {
-    (0..p.len())
-        .map(|i| 0.5 * p.mass[i] * p.v[i].norm_squared())
-        .sum()
+    (0..p.len()).map(|i| 0.5 * p.mass[i] * p.v[i].norm_squared()).sum()
 }
 
 // ---------------------------------------------------------------- search
@@ -259,14 +231,7 @@ fn search_matches_brute_force_on_a_fine_outline() {
 /// (inside, reuse deliberately keeps the face crossed: `search` module doc).
 #[test]
 fn pairing_reuse_agrees_with_fresh_search_outside() {
-    let body = RigidBody::new(
-        "p",
-        rectangle_outline(20.0, 80.0),
-        Vec2::zeros(),
-        Vec2::zeros(),
-        1.0,
-    )
-    .unwrap();
+    let body = RigidBody::new("p", rectangle_outline(20.0, 80.0), Vec2::zeros(), Vec2::zeros(), 1.0).unwrap();
     let o = Vec2::zeros();
     let mut last: Option<MasterFeature> = None;
     let mut reused = 0;
@@ -287,10 +252,7 @@ fn pairing_reuse_agrees_with_fresh_search_outside() {
         assert_eq!(got, fresh, "step {k}, y = {y:?}");
         last = Some(got.feature);
     }
-    assert!(
-        reused > 3900,
-        "reuse should be the common case, got {reused}"
-    );
+    assert!(reused > 3900, "reuse should be the common case, got {reused}");
 }
 
 // ---------------------------------------------------------------- forces
@@ -306,10 +268,7 @@ fn one_step_normal_force_puts_free_particle_on_surface() {
     let mut p = single_particle(Vec2::new(0.0, 1e-6), 2e-4);
     p.v[0] = Vec2::new(3.0, -40.0);
     p.f_ext[0] = Vec2::new(0.5, -2.0);
-    let none = ContactParameters {
-        spreading: Spreading::None,
-        ..ContactParameters::default()
-    };
+    let none = ContactParameters { spreading: Spreading::None, ..ContactParameters::default() };
     let mut sys = ContactSystem::new(vec![wall(0.0)], SlaveSet::from_indices([0]), none).unwrap();
     let mut f = Vec::new();
     let r = step(&mut sys, &mut p, None, dt, &mut f);
@@ -317,18 +276,11 @@ fn one_step_normal_force_puts_free_particle_on_surface() {
     let g_pred = sys.contacts()[0].gap;
     assert!(g_pred < -1e-6);
     let y_end = p.x0[0].y + p.u[0].y;
-    assert!(
-        y_end.abs() <= 1e-12 * g_pred.abs(),
-        "end gap {y_end:e}, predicted {g_pred:e}"
-    );
+    assert!(y_end.abs() <= 1e-12 * g_pred.abs(), "end gap {y_end:e}, predicted {g_pred:e}");
     assert_eq!(p.v[0].x, 3.0 + dt * 0.5 / 2e-4); // frictionless: tangential motion untouched
 
     // (b) a wedge (inclined faces) driven at a prescribed velocity
-    let wedge = vec![
-        Vec2::new(0.0, -1e-3),
-        Vec2::new(2e-3, 1e-3),
-        Vec2::new(-2e-3, 1e-3),
-    ];
+    let wedge = vec![Vec2::new(0.0, -1e-3), Vec2::new(2e-3, 1e-3), Vec2::new(-2e-3, 1e-3)];
     let body = RigidBody::new("wedge", wedge, Vec2::new(0.0, 0.0), Vec2::zeros(), 1.0)
         .unwrap()
         .with_prescribed_velocity(Vec2::new(5.0, -30.0));
@@ -340,14 +292,8 @@ fn one_step_normal_force_puts_free_particle_on_surface() {
     let c = sys.contacts()[0];
     assert_eq!(c.pairing.feature, MasterFeature::Segment(0));
     let x = p.x0[0] + p.u[0];
-    let g_end = search_rigid_polygon(&sys.bodies[0], &sys.bodies[0].position, &x, &x)
-        .unwrap()
-        .gap;
-    assert!(
-        g_end.abs() <= 1e-12 * c.gap.abs(),
-        "end gap {g_end:e}, predicted {:e}",
-        c.gap
-    );
+    let g_end = search_rigid_polygon(&sys.bodies[0], &sys.bodies[0].position, &x, &x).unwrap().gap;
+    assert!(g_end.abs() <= 1e-12 * c.gap.abs(), "end gap {g_end:e}, predicted {:e}", c.gap);
 }
 
 /// With [`Spreading::ShapeFunction`] the gap point is the physical point
@@ -365,21 +311,13 @@ fn shape_function_contact_of_an_isolated_point_is_exact() {
         p.f_int[i] = Vec2::new(splitmix(&mut s) - 0.5, splitmix(&mut s) - 0.5) * 1e3;
     }
     let slave = 4 * 7 + 3; // top row, middle
-    let params = ContactParameters {
-        spreading: Spreading::ShapeFunction,
-        ..ContactParameters::default()
-    };
+    let params = ContactParameters { spreading: Spreading::ShapeFunction, ..ContactParameters::default() };
     // A punch driven down, its nose 1 µm above the slave's physical point.
     let y_phys = p.x0[slave].y + shape.interpolate(slave, &p.u).y;
-    let punch = RigidBody::new(
-        "punch",
-        rectangle_outline(1.0, 0.2),
-        Vec2::new(0.0, y_phys + 1e-6 + 0.1),
-        Vec2::zeros(),
-        1.0,
-    )
-    .unwrap()
-    .with_prescribed_velocity(Vec2::new(0.0, -20.0));
+    let punch =
+        RigidBody::new("punch", rectangle_outline(1.0, 0.2), Vec2::new(0.0, y_phys + 1e-6 + 0.1), Vec2::zeros(), 1.0)
+            .unwrap()
+            .with_prescribed_velocity(Vec2::new(0.0, -20.0));
     let mut sys = ContactSystem::new(vec![punch], SlaveSet::from_indices([slave]), params).unwrap();
     let mut f = Vec::new();
     step(&mut sys, &mut p, Some(&shape), 1e-7, &mut f);
@@ -393,11 +331,7 @@ fn shape_function_contact_of_an_isolated_point_is_exact() {
     let nose = sys.bodies[0].position.y - 0.1;
     let y_phys = p.x0[slave].y + shape.interpolate(slave, &p.u).y;
     let g_end = nose - y_phys;
-    assert!(
-        g_end.abs() <= 1e-10 * c.gap.abs(),
-        "end gap {g_end:e}, predicted {:e}",
-        c.gap
-    );
+    assert!(g_end.abs() <= 1e-10 * c.gap.abs(), "end gap {g_end:e}, predicted {:e}", c.gap);
     // more than one particle received force, and f_J = N_J F
     let row: Vec<usize> = shape.range(slave).collect();
     assert!(row.len() > 4);
@@ -414,20 +348,11 @@ fn shape_function_contact_of_an_isolated_point_is_exact() {
 fn falling_particle_never_penetrates_a_wall() {
     for mode in MODES {
         let mut p = single_particle(Vec2::new(0.0, 2e-4), 1e-4);
-        let shape = ShapeTable {
-            offsets: vec![0, 1],
-            index: vec![0],
-            value: vec![1.0],
-            grad: vec![Vec2::zeros()],
-        };
+        let shape = ShapeTable { offsets: vec![0, 1], index: vec![0], value: vec![1.0], grad: vec![Vec2::zeros()] };
         p.v[0] = Vec2::new(0.0, -3.0);
         p.f_ext[0] = Vec2::new(0.0, -1e-4 * 5e4); // 5e4 m/s² "gravity"
-        let params = ContactParameters {
-            spreading: mode,
-            ..ContactParameters::default()
-        };
-        let mut sys =
-            ContactSystem::new(vec![wall(0.0)], SlaveSet::from_indices([0]), params).unwrap();
+        let params = ContactParameters { spreading: mode, ..ContactParameters::default() };
+        let mut sys = ContactSystem::new(vec![wall(0.0)], SlaveSet::from_indices([0]), params).unwrap();
         let (dt, mut f, mut landed_at) = (1e-6, Vec::new(), None);
         for n in 0..400 {
             let r = step(&mut sys, &mut p, Some(&shape), dt, &mut f);
@@ -439,10 +364,7 @@ fn falling_particle_never_penetrates_a_wall() {
         }
         let n0 = landed_at.expect("it lands");
         assert!(n0 > 10 && n0 < 100, "{mode:?}: landed at step {n0}");
-        assert!(
-            (p.x0[0].y + p.u[0].y).abs() < 1e-15 && p.v[0].norm() < 1e-9,
-            "{mode:?}: resting"
-        );
+        assert!((p.x0[0].y + p.u[0].y).abs() < 1e-15 && p.v[0].norm() < 1e-9, "{mode:?}: resting");
         // resting: the contact carries exactly the load
         let f_n = sys.contacts()[0].normal_force;
         assert!(
@@ -464,11 +386,8 @@ fn coulomb_slip_decelerates_at_mu_n_over_m() {
     let mut p = single_particle(Vec2::zeros(), m);
     p.v[0] = Vec2::new(v0, 0.0);
     p.f_ext[0] = Vec2::new(0.0, -load);
-    let params = ContactParameters {
-        friction_coefficient: mu,
-        spreading: Spreading::None,
-        ..ContactParameters::default()
-    };
+    let params =
+        ContactParameters { friction_coefficient: mu, spreading: Spreading::None, ..ContactParameters::default() };
     let mut sys = ContactSystem::new(vec![wall(0.0)], SlaveSet::from_indices([0]), params).unwrap();
     let decel = mu * load / m;
     let mut f = Vec::new();
@@ -481,11 +400,7 @@ fn coulomb_slip_decelerates_at_mu_n_over_m() {
         let expected = v0 - n as Real * dt * decel;
         if expected > 0.0 {
             assert!(c.slipping);
-            assert!(
-                (p.v[0].x - expected).abs() < 1e-9,
-                "step {n}: v = {}, expected {expected}",
-                p.v[0].x
-            );
+            assert!((p.v[0].x - expected).abs() < 1e-9, "step {n}: v = {}, expected {expected}", p.v[0].x);
         } else {
             stopped.get_or_insert(n);
             assert!(p.v[0].x.abs() < 1e-15, "step {n}: sticks");
@@ -501,28 +416,17 @@ fn coulomb_slip_decelerates_at_mu_n_over_m() {
 #[test]
 fn friction_sticks_below_the_cap_and_is_off_at_mu_zero() {
     let (m, load, dt) = (1e-3, 1.0, 1e-4);
-    for (mu, pull, accel) in [
-        (0.3, 0.2, 0.0),
-        (0.3, 0.4, (0.4 - 0.3) / 1e-3),
-        (0.0, 0.2, 0.2 / 1e-3),
-    ] {
+    for (mu, pull, accel) in [(0.3, 0.2, 0.0), (0.3, 0.4, (0.4 - 0.3) / 1e-3), (0.0, 0.2, 0.2 / 1e-3)] {
         let mut p = single_particle(Vec2::zeros(), m);
         p.f_ext[0] = Vec2::new(pull, -load);
-        let params = ContactParameters {
-            friction_coefficient: mu,
-            spreading: Spreading::None,
-            ..ContactParameters::default()
-        };
-        let mut sys =
-            ContactSystem::new(vec![wall(0.0)], SlaveSet::from_indices([0]), params).unwrap();
+        let params =
+            ContactParameters { friction_coefficient: mu, spreading: Spreading::None, ..ContactParameters::default() };
+        let mut sys = ContactSystem::new(vec![wall(0.0)], SlaveSet::from_indices([0]), params).unwrap();
         let mut f = Vec::new();
         for n in 1..=50 {
             step(&mut sys, &mut p, None, dt, &mut f);
             let c = sys.contacts()[0];
-            assert!(
-                (p.v[0].x - n as Real * dt * accel).abs() < 1e-9,
-                "μ {mu}, pull {pull}: step {n}"
-            );
+            assert!((p.v[0].x - n as Real * dt * accel).abs() < 1e-9, "μ {mu}, pull {pull}: step {n}");
             if mu == 0.0 {
                 assert_eq!(c.tangential_force, 0.0);
             } else if accel == 0.0 {
@@ -545,51 +449,23 @@ fn spreading_conserves_the_total_force() {
             p.v[i] = Vec2::new(splitmix(&mut s) - 0.5, splitmix(&mut s) - 0.5) * 20.0;
         }
         // a diamond pressed into the top surface: inclined normals
-        let diamond = vec![
-            Vec2::new(0.0, -2.0 * h),
-            Vec2::new(2.0 * h, 0.0),
-            Vec2::new(0.0, 2.0 * h),
-            Vec2::new(-2.0 * h, 0.0),
-        ];
-        let body = RigidBody::new(
-            "diamond",
-            diamond,
-            Vec2::new(0.1 * h, 0.5 * h),
-            Vec2::new(0.0, -50.0),
-            1.0,
-        )
-        .unwrap();
+        let diamond =
+            vec![Vec2::new(0.0, -2.0 * h), Vec2::new(2.0 * h, 0.0), Vec2::new(0.0, 2.0 * h), Vec2::new(-2.0 * h, 0.0)];
+        let body = RigidBody::new("diamond", diamond, Vec2::new(0.1 * h, 0.5 * h), Vec2::new(0.0, -50.0), 1.0).unwrap();
         let slaves = SlaveSet::detect(&p.x0, &p.spacing, &SurfaceDetection::default()).unwrap();
-        let params = ContactParameters {
-            spreading: mode,
-            friction_coefficient: 0.3,
-            ..ContactParameters::default()
-        };
+        let params = ContactParameters { spreading: mode, friction_coefficient: 0.3, ..ContactParameters::default() };
         let mut sys = ContactSystem::new(vec![body], slaves, params).unwrap();
         let mut f = vec![Vec2::zeros(); p.len()];
-        let report = sys
-            .compute_forces(&StepInput::from_particles(&p, Some(&shape), 1e-6), &mut f)
-            .unwrap();
-        assert!(
-            report.active_contacts >= 2,
-            "{mode:?}: {} contacts",
-            report.active_contacts
-        );
+        let report = sys.compute_forces(&StepInput::from_particles(&p, Some(&shape), 1e-6), &mut f).unwrap();
+        assert!(report.active_contacts >= 2, "{mode:?}: {} contacts", report.active_contacts);
         for c in sys.contacts() {
             let t = Vec2::new(-c.normal.y, c.normal.x);
             let intended = c.normal * c.normal_force + t * c.tangential_force;
-            assert!(
-                (c.force - intended).norm() <= 1e-15 * intended.norm(),
-                "{mode:?}: {:?} vs {intended:?}",
-                c.force
-            );
+            assert!((c.force - intended).norm() <= 1e-15 * intended.norm(), "{mode:?}: {:?} vs {intended:?}", c.force);
         }
         let total: Vec2 = f.iter().sum();
         let reaction = sys.sample(0).unwrap().contact_force;
-        assert!(
-            (total + reaction).norm() <= 1e-15 * total.norm(),
-            "{mode:?}"
-        );
+        assert!((total + reaction).norm() <= 1e-15 * total.norm(), "{mode:?}");
         assert!((total - report.force_on_particles).norm() <= 1e-15 * total.norm());
         let receivers = f.iter().filter(|v| v.norm() > 0.0).count();
         match mode {
@@ -623,11 +499,7 @@ fn momentum_and_energy_with_a_free_body() {
         )
         .unwrap();
         let slaves = SlaveSet::detect(&p.x0, &p.spacing, &SurfaceDetection::default()).unwrap();
-        let params = ContactParameters {
-            spreading: mode,
-            friction_coefficient: 0.2,
-            ..ContactParameters::default()
-        };
+        let params = ContactParameters { spreading: mode, friction_coefficient: 0.2, ..ContactParameters::default() };
         let mut sys = ContactSystem::new(vec![body], slaves, params).unwrap();
         let momentum = |p: &Particles, sys: &ContactSystem| p.momentum() + sys.body_momentum();
         let energy = |p: &Particles, sys: &ContactSystem| {
@@ -643,16 +515,9 @@ fn momentum_and_energy_with_a_free_body() {
             let dp = (momentum(&p, &sys) - p0).norm();
             assert!(dp <= 1e-12 * p0.norm(), "{mode:?}: momentum drift {dp:e}");
         }
-        assert!(
-            active_steps > 5,
-            "{mode:?}: contact happened ({active_steps} steps)"
-        );
+        assert!(active_steps > 5, "{mode:?}: contact happened ({active_steps} steps)");
         let de = energy(&p, &sys) - e0;
-        assert!(
-            (de - sys.contact_work()).abs() <= 1e-10 * e0,
-            "{mode:?}: ΔKE {de:e} vs W {:e}",
-            sys.contact_work()
-        );
+        assert!((de - sys.contact_work()).abs() <= 1e-10 * e0, "{mode:?}: ΔKE {de:e} vs W {:e}", sys.contact_work());
         assert!(sys.contact_work() < 0.0, "{mode:?}: contact dissipates");
     }
 }
@@ -670,24 +535,12 @@ fn rigid_body_masses() {
     let cylinder = std::f64::consts::PI * 0.010f64.powi(2) * 0.080 * STEEL_DENSITY;
     assert!((cylinder - 0.1973).abs() < 1e-4);
     let whole = mass_axisymmetric(&section, STEEL_DENSITY).unwrap();
-    let half: Vec<Vec2> = vec![
-        Vec2::new(0.0, -0.04),
-        Vec2::new(0.01, -0.04),
-        Vec2::new(0.01, 0.04),
-        Vec2::new(0.0, 0.04),
-    ];
+    let half: Vec<Vec2> =
+        vec![Vec2::new(0.0, -0.04), Vec2::new(0.01, -0.04), Vec2::new(0.01, 0.04), Vec2::new(0.0, 0.04)];
     let right = mass_axisymmetric(&half, STEEL_DENSITY).unwrap();
-    assert!(
-        (whole - cylinder).abs() < 1e-14 && (right - cylinder).abs() < 1e-14,
-        "{whole} {right} {cylinder}"
-    );
+    assert!((whole - cylinder).abs() < 1e-14 && (right - cylinder).abs() < 1e-14, "{whole} {right} {cylinder}");
     // a ring section r ∈ [1, 2] mm, 1 mm tall: π (2² − 1²) mm³ · 1 mm
-    let ring = vec![
-        Vec2::new(1e-3, 0.0),
-        Vec2::new(2e-3, 0.0),
-        Vec2::new(2e-3, 1e-3),
-        Vec2::new(1e-3, 1e-3),
-    ];
+    let ring = vec![Vec2::new(1e-3, 0.0), Vec2::new(2e-3, 0.0), Vec2::new(2e-3, 1e-3), Vec2::new(1e-3, 1e-3)];
     let v = mass_axisymmetric(&ring, 1.0).unwrap();
     assert!((v - std::f64::consts::PI * 3e-9).abs() < 1e-22);
     assert!(mass_plane_strain(&section, -1.0).is_err());
@@ -698,9 +551,7 @@ fn rigid_body_masses() {
 // ---------------------------------------------------------------- surface
 
 fn boundary_of_lattice(nx: usize, ny: usize) -> Vec<usize> {
-    (0..nx * ny)
-        .filter(|k| k % nx == 0 || k % nx == nx - 1 || k / nx == 0 || k / nx == ny - 1)
-        .collect()
+    (0..nx * ny).filter(|k| k % nx == 0 || k % nx == nx - 1 || k / nx == 0 || k / nx == ny - 1).collect()
 }
 
 #[test]
@@ -767,45 +618,18 @@ fn surface_of_disc() {
 #[test]
 fn bad_inputs_are_errors_not_panics() {
     let mut p = single_particle(Vec2::zeros(), 1e-3);
-    let mut sys = ContactSystem::new(
-        vec![wall(1e-3)],
-        SlaveSet::from_indices([0]),
-        ContactParameters::default(),
-    )
-    .unwrap();
+    let mut sys =
+        ContactSystem::new(vec![wall(1e-3)], SlaveSet::from_indices([0]), ContactParameters::default()).unwrap();
     let mut f = vec![Vec2::zeros(); 1];
     let r = sys.compute_forces(&StepInput::from_particles(&p, None, 1e-6), &mut f);
     assert!(matches!(r, Err(ContactError::MissingShapeTable { .. })));
-    assert!(matches!(
-        sys.advance(&p.v),
-        Err(ContactError::AdvanceWithoutForces)
-    ));
-    let bad_table = ShapeTable {
-        offsets: vec![0, 1],
-        index: vec![0],
-        value: vec![0.7],
-        grad: vec![Vec2::zeros()],
-    };
-    let r = sys.compute_forces(
-        &StepInput::from_particles(&p, Some(&bad_table), 1e-6),
-        &mut f,
-    );
-    assert!(
-        matches!(r, Err(ContactError::PartitionOfUnity { particle: 0, .. })),
-        "{r:?}"
-    );
-    let r = sys.compute_forces(
-        &StepInput::from_particles(&p, None, 1e-6),
-        &mut [Vec2::zeros(); 2],
-    );
-    assert!(matches!(
-        r,
-        Err(ContactError::MissingShapeTable { .. }) | Err(ContactError::LengthMismatch { .. })
-    ));
-    let none = ContactParameters {
-        spreading: Spreading::None,
-        ..ContactParameters::default()
-    };
+    assert!(matches!(sys.advance(&p.v), Err(ContactError::AdvanceWithoutForces)));
+    let bad_table = ShapeTable { offsets: vec![0, 1], index: vec![0], value: vec![0.7], grad: vec![Vec2::zeros()] };
+    let r = sys.compute_forces(&StepInput::from_particles(&p, Some(&bad_table), 1e-6), &mut f);
+    assert!(matches!(r, Err(ContactError::PartitionOfUnity { particle: 0, .. })), "{r:?}");
+    let r = sys.compute_forces(&StepInput::from_particles(&p, None, 1e-6), &mut [Vec2::zeros(); 2]);
+    assert!(matches!(r, Err(ContactError::MissingShapeTable { .. }) | Err(ContactError::LengthMismatch { .. })));
+    let none = ContactParameters { spreading: Spreading::None, ..ContactParameters::default() };
     let mut sys = ContactSystem::new(vec![wall(1e-3)], SlaveSet::from_indices([0]), none).unwrap();
     assert!(matches!(
         sys.compute_forces(&StepInput::from_particles(&p, None, 0.0), &mut f),
@@ -827,40 +651,19 @@ fn bad_inputs_are_errors_not_panics() {
         sys.compute_forces(&StepInput::from_particles(&p, None, 1e-6), &mut f),
         Err(ContactError::SlaveOutOfRange { .. })
     ));
-    let broken = ShapeTable {
-        offsets: vec![0, 3],
-        index: vec![0],
-        value: vec![1.0],
-        grad: vec![Vec2::zeros()],
-    };
-    let mut sys = ContactSystem::new(
-        vec![wall(1e-3)],
-        SlaveSet::from_indices([0]),
-        ContactParameters::default(),
-    )
-    .unwrap();
+    let broken = ShapeTable { offsets: vec![0, 3], index: vec![0], value: vec![1.0], grad: vec![Vec2::zeros()] };
+    let mut sys =
+        ContactSystem::new(vec![wall(1e-3)], SlaveSet::from_indices([0]), ContactParameters::default()).unwrap();
     p.u[0].x = 0.0;
     assert!(matches!(
         sys.compute_forces(&StepInput::from_particles(&p, Some(&broken), 1e-6), &mut f),
         Err(ContactError::InvalidShapeTable)
     ));
-    let good = ShapeTable {
-        offsets: vec![0, 1],
-        index: vec![0],
-        value: vec![1.0],
-        grad: vec![Vec2::zeros()],
-    };
-    sys.compute_forces(&StepInput::from_particles(&p, Some(&good), 1e-6), &mut f)
-        .unwrap();
-    assert!(matches!(
-        sys.advance(&[]),
-        Err(ContactError::LengthMismatch { field: "v", .. })
-    ));
+    let good = ShapeTable { offsets: vec![0, 1], index: vec![0], value: vec![1.0], grad: vec![Vec2::zeros()] };
+    sys.compute_forces(&StepInput::from_particles(&p, Some(&good), 1e-6), &mut f).unwrap();
+    assert!(matches!(sys.advance(&[]), Err(ContactError::LengthMismatch { field: "v", .. })));
     sys.advance(&p.v).unwrap();
-    let bad = ContactParameters {
-        friction_coefficient: -0.1,
-        ..ContactParameters::default()
-    };
+    let bad = ContactParameters { friction_coefficient: -0.1, ..ContactParameters::default() };
     assert!(ContactSystem::new(vec![], SlaveSet::new(), bad).is_err());
 }
 
@@ -897,17 +700,8 @@ impl ElasticBlock {
         }
         let qp = rk_table(&p.x0, &p.volume, &p.support, &pts);
         let (e, nu) = (Self::YOUNG, Self::POISSON);
-        let lame = (
-            e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
-            e / (2.0 * (1.0 + nu)),
-        );
-        Self {
-            p,
-            shape,
-            qp,
-            qp_weight: w,
-            lame,
-        }
+        let lame = (e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), e / (2.0 * (1.0 + nu)));
+        Self { p, shape, qp, qp_weight: w, lame }
     }
 
     /// Longitudinal wave speed `c_L = sqrt((λ + 2μ)/ρ)`.
@@ -932,16 +726,11 @@ impl ElasticBlock {
                 hyy += U.y * g.y;
             }
             let (exy, tr) = (0.5 * (hxy + hyx), hxx + hyy);
-            let (sxx, syy, sxy) = (
-                lam * tr + 2.0 * mu * hxx,
-                lam * tr + 2.0 * mu * hyy,
-                2.0 * mu * exy,
-            );
+            let (sxx, syy, sxy) = (lam * tr + 2.0 * mu * hxx, lam * tr + 2.0 * mu * hyy, 2.0 * mu * exy);
             let w = self.qp_weight[q];
             for e in t.range(q) {
                 let g = t.grad[e];
-                p.f_int[t.index[e] as usize] +=
-                    Vec2::new(sxx * g.x + sxy * g.y, sxy * g.x + syy * g.y) * w;
+                p.f_int[t.index[e] as usize] += Vec2::new(sxx * g.x + sxy * g.y, sxy * g.x + syy * g.y) * w;
             }
         }
     }
@@ -991,9 +780,7 @@ fn punch_impact(
     let x_mid = 0.5 * (xs[0] + xs[nx - 1]);
     let half = 0.5 * punch_width;
     // sample points of the physical surface under the punch
-    let top: Vec<usize> = ((ny - 1) * nx..ny * nx)
-        .filter(|&i| (b.p.x0[i].x - x_mid).abs() <= half + 1e-12)
-        .collect();
+    let top: Vec<usize> = ((ny - 1) * nx..ny * nx).filter(|&i| (b.p.x0[i].x - x_mid).abs() <= half + 1e-12).collect();
     let mut samples: Vec<Vec2> = top.iter().map(|&i| b.p.x0[i]).collect();
     samples.extend(top.windows(2).map(|w| 0.5 * (b.p.x0[w[0]] + b.p.x0[w[1]])));
     let surf = rk_table(&b.p.x0, &b.p.volume, &b.p.support, &samples);
@@ -1008,10 +795,7 @@ fn punch_impact(
     .unwrap()
     .with_prescribed_velocity(Vec2::new(0.0, -v0));
     let slaves = SlaveSet::detect(&b.p.x0, &b.p.spacing, &SurfaceDetection::default()).unwrap();
-    let params = ContactParameters {
-        spreading: mode,
-        ..ContactParameters::default()
-    };
+    let params = ContactParameters { spreading: mode, ..ContactParameters::default() };
     let mut sys = ContactSystem::new(vec![punch], slaves, params).unwrap();
     let dt = 0.3 * h / b.wave_speed();
     let (mut f, mut forces) = (Vec::new(), Vec::new());
@@ -1019,13 +803,9 @@ fn punch_impact(
     let mut iterations = 0;
     for _ in 0..steps {
         b.internal_force();
-        iterations =
-            iterations.max(step(&mut sys, &mut b.p, Some(&b.shape), dt, &mut f).iterations);
+        iterations = iterations.max(step(&mut sys, &mut b.p, Some(&b.shape), dt, &mut f).iterations);
         forces.push(sys.sample(0).unwrap().contact_force.y);
-        let (nose, centre) = (
-            sys.bodies[0].position.y - 0.5 * height,
-            sys.bodies[0].position.x,
-        );
+        let (nose, centre) = (sys.bodies[0].position.y - 0.5 * height, sys.bodies[0].position.x);
         // strictly under the nose: a point on the side face's line is not inside
         let under = |x: &Vec2| (x.x - centre).abs() < half - 1e-6 * h;
         for k in 0..samples.len() {
@@ -1040,21 +820,12 @@ fn punch_impact(
                 pen_gen = pen_gen.max(x.y - nose);
             }
         }
-        assert!(
-            b.p.u.iter().all(|u| u.iter().all(|c| c.is_finite())),
-            "{mode:?}: finite"
-        );
+        assert!(b.p.u.iter().all(|u| u.iter().all(|c| c.is_finite())), "{mode:?}: finite");
     }
     let tail = &forces[steps / 3..];
     let mean = tail.iter().sum::<Real>() / tail.len() as Real;
-    let chatter = tail.windows(2).map(|w| (w[1] - w[0]).abs()).sum::<Real>()
-        / (tail.len() - 1) as Real
-        / mean;
-    let width = if uniaxial {
-        xs[nx - 1] - xs[0]
-    } else {
-        punch_width
-    };
+    let chatter = tail.windows(2).map(|w| (w[1] - w[0]).abs()).sum::<Real>() / (tail.len() - 1) as Real / mean;
+    let width = if uniaxial { xs[nx - 1] - xs[0] } else { punch_width };
     let s = sys.sample(0).unwrap();
     ImpactMetrics {
         force_ratio: mean / (STEEL_DENSITY * b.wave_speed() * v0 * width),
@@ -1093,39 +864,15 @@ fn punch_impact(
 fn compare_spreading_on_elastic_impact() {
     let h = 1e-3;
     let run = |mode| {
-        let a = punch_impact(
-            mode,
-            &uniform(8, h, 0.0),
-            &uniform(61, h, -60.0 * h),
-            true,
-            20.0 * h,
-            50.0,
-            120,
-        );
-        let b = punch_impact(
-            mode,
-            &uniform(41, h, -20.0 * h),
-            &uniform(21, h, -20.0 * h),
-            false,
-            10.0 * h,
-            50.0,
-            50,
-        );
+        let a = punch_impact(mode, &uniform(8, h, 0.0), &uniform(61, h, -60.0 * h), true, 20.0 * h, 50.0, 120);
+        let b = punch_impact(mode, &uniform(41, h, -20.0 * h), &uniform(21, h, -20.0 * h), false, 10.0 * h, 50.0, 50);
         println!("{mode:?}\n  (A) uniaxial: {a:?}\n  (B) punch:    {b:?}");
         (a, b)
     };
-    let (none, id, sf) = (
-        run(Spreading::None),
-        run(Spreading::InverseDistance),
-        run(Spreading::ShapeFunction),
-    );
+    let (none, id, sf) = (run(Spreading::None), run(Spreading::InverseDistance), run(Spreading::ShapeFunction));
     for (a, _) in [&none, &id, &sf] {
         // every mode transmits the plane-wave pressure on average
-        assert!(
-            (a.force_ratio - 1.0).abs() < 0.05,
-            "force ratio {}",
-            a.force_ratio
-        );
+        assert!((a.force_ratio - 1.0).abs() < 0.05, "force ratio {}", a.force_ratio);
     }
     // uniaxial: the face stays on the punch, without chatter, where the
     // contact is point-wise exact
@@ -1134,27 +881,12 @@ fn compare_spreading_on_elastic_impact() {
         "None is exact at X_s + U_s"
     );
     for (a, _) in [&none, &sf] {
-        assert!(
-            a.physical_penetration < 1e-6 && a.chatter < 0.05 && a.dissipation < 0.02,
-            "{a:?}"
-        );
+        assert!(a.physical_penetration < 1e-6 && a.chatter < 0.05 && a.dissipation < 0.02, "{a:?}");
     }
     // punch with corners: the ranking that makes ShapeFunction the default
     let (sf_b, none_b, id_b) = (&sf.1, &none.1, &id.1);
-    assert!(
-        sf_b.physical_penetration < 0.6 * none_b.physical_penetration,
-        "{sf_b:?} vs {none_b:?}"
-    );
-    assert!(
-        sf_b.physical_penetration < 0.8 * id_b.physical_penetration,
-        "{sf_b:?} vs {id_b:?}"
-    );
-    assert!(
-        sf_b.chatter < 0.5 * id_b.chatter && sf_b.dissipation < 0.3 * id_b.dissipation,
-        "{sf_b:?} vs {id_b:?}"
-    );
-    assert!(
-        sf.0.iterations < 50 && sf_b.iterations < 50,
-        "Gauss-Seidel converged within the default cap"
-    );
+    assert!(sf_b.physical_penetration < 0.6 * none_b.physical_penetration, "{sf_b:?} vs {none_b:?}");
+    assert!(sf_b.physical_penetration < 0.8 * id_b.physical_penetration, "{sf_b:?} vs {id_b:?}");
+    assert!(sf_b.chatter < 0.5 * id_b.chatter && sf_b.dissipation < 0.3 * id_b.dissipation, "{sf_b:?} vs {id_b:?}");
+    assert!(sf.0.iterations < 50 && sf_b.iterations < 50, "Gauss-Seidel converged within the default cap");
 }

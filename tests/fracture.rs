@@ -20,13 +20,7 @@ use plugsim::step::{Simulation, TimeStepRule};
 const H: Real = 0.5e-3;
 
 fn steel() -> Elastic {
-    Elastic {
-        density: 7850.0,
-        youngs_modulus: 200e9,
-        poisson_ratio: 0.3,
-        room_temperature: 293.0,
-        thermal: None,
-    }
+    Elastic { density: 7850.0, youngs_modulus: 200e9, poisson_ratio: 0.3, room_temperature: 293.0, thermal: None }
 }
 
 /// A uniform `nx × ny` lattice of spacing `H` on `[0, (nx−1)H] × [0, (ny−1)H]`
@@ -56,12 +50,7 @@ fn plate(nx: usize, ny: usize) -> Model {
     };
     let mut m = Model::build(GeometryMode::PlaneStrain, &[body]).unwrap();
     assert_eq!(m.particles.len(), nx * ny);
-    let slaves = SlaveSet::detect(
-        &m.particles.x0,
-        &m.particles.spacing,
-        &SurfaceDetection::default(),
-    )
-    .unwrap();
+    let slaves = SlaveSet::detect(&m.particles.x0, &m.particles.spacing, &SurfaceDetection::default()).unwrap();
     slaves.mark_flags(&mut m.particles.flags).unwrap();
     m
 }
@@ -75,10 +64,7 @@ fn id(m: &Model, i: usize, j: usize) -> usize {
 }
 
 fn params(criterion: Criterion) -> FractureParameters {
-    FractureParameters {
-        criterion,
-        ..FractureParameters::default()
-    }
+    FractureParameters { criterion, ..FractureParameters::default() }
 }
 
 fn orient(a: &Vec2, b: &Vec2, x: &Vec2) -> Real {
@@ -92,12 +78,7 @@ fn strictly_crosses(a: &Vec2, b: &Vec2, x: &Vec2, p: &Vec2) -> bool {
     let tol = 1e-9 * H;
     let (o1, o2) = (orient(a, b, x), orient(a, b, p));
     let (o3, o4) = (orient(x, p, a), orient(x, p, b));
-    o1.abs() > tol
-        && o2.abs() > tol
-        && o1 * o2 < 0.0
-        && o3.abs() > tol
-        && o4.abs() > tol
-        && o3 * o4 < 0.0
+    o1.abs() > tol && o2.abs() > tol && o1 * o2 < 0.0 && o3.abs() > tol && o4.abs() > tol && o3 * o4 < 0.0
 }
 
 struct Invariants {
@@ -106,10 +87,7 @@ struct Invariants {
 }
 
 fn snapshot(m: &Model) -> Invariants {
-    Invariants {
-        mass: m.particles.total_mass(),
-        momentum: m.particles.momentum(),
-    }
+    Invariants { mass: m.particles.total_mass(), momentum: m.particles.momentum() }
 }
 
 /// Mass and momentum unchanged, reproduction at every quadrature point,
@@ -117,17 +95,10 @@ fn snapshot(m: &Model) -> Invariants {
 fn check_invariants(m: &Model, growth: &CrackGrowth, before: &Invariants, what: &str) {
     let p = &m.particles;
     let mass = p.total_mass();
-    assert!(
-        (mass - before.mass).abs() <= 1e-12 * before.mass,
-        "{what}: mass {mass} vs {}",
-        before.mass
-    );
+    assert!((mass - before.mass).abs() <= 1e-12 * before.mass, "{what}: mass {mass} vs {}", before.mass);
     let vmax = p.v.iter().map(|v| v.norm()).fold(0.0, Real::max).max(1.0);
     let dp = (p.momentum() - before.momentum).norm();
-    assert!(
-        dp <= 1e-12 * before.mass * vmax,
-        "{what}: momentum changed by {dp:e}"
-    );
+    assert!(dp <= 1e-12 * before.mass * vmax, "{what}: momentum changed by {dp:e}");
     eprintln!(
         "{what}: relative mass error {:.2e}, momentum error {:.2e} (of M v_max)",
         (mass - before.mass).abs() / before.mass,
@@ -135,12 +106,7 @@ fn check_invariants(m: &Model, growth: &CrackGrowth, before: &Invariants, what: 
     );
     let t = &m.qp_shape;
     for q in 0..t.rows() {
-        let (mut s, mut sx, mut g, mut gx) = (
-            0.0,
-            Vec2::zeros(),
-            Vec2::zeros(),
-            nalgebra::Matrix2::<Real>::zeros(),
-        );
+        let (mut s, mut sx, mut g, mut gx) = (0.0, Vec2::zeros(), Vec2::zeros(), nalgebra::Matrix2::<Real>::zeros());
         for k in t.range(q) {
             let i = t.index[k] as usize;
             s += t.value[k];
@@ -149,32 +115,18 @@ fn check_invariants(m: &Model, growth: &CrackGrowth, before: &Invariants, what: 
             gx += p.x0[i] * t.grad[k].transpose();
         }
         let x = m.quad.x0[q];
-        assert!(
-            (s - 1.0).abs() < 1e-9,
-            "{what}: partition of unity at qp {q}: {s}"
-        );
+        assert!((s - 1.0).abs() < 1e-9, "{what}: partition of unity at qp {q}: {s}");
         assert!(g.norm() < 1e-6 / H, "{what}: gradient sum at qp {q}: {g:?}");
         if growth.reduced_quadrature_rows.get(&q) == Some(&Basis::Constant) {
             continue; // no full neighbourhood: partition of unity only
         }
-        assert!(
-            (sx - x).norm() < 1e-9 * H,
-            "{what}: linear reproduction at qp {q}"
-        );
-        assert!(
-            (gx - nalgebra::Matrix2::identity()).norm() < 1e-7,
-            "{what}: gradient reproduction at qp {q}"
-        );
+        assert!((sx - x).norm() < 1e-9 * H, "{what}: linear reproduction at qp {q}");
+        assert!((gx - nalgebra::Matrix2::identity()).norm() < 1e-7, "{what}: gradient reproduction at qp {q}");
     }
     let segs: Vec<(Vec2, Vec2)> = growth
         .cracks
         .iter()
-        .flat_map(|c| {
-            c.vertices
-                .windows(2)
-                .map(|w| (w[0].x0, w[1].x0))
-                .collect::<Vec<_>>()
-        })
+        .flat_map(|c| c.vertices.windows(2).map(|w| (w[0].x0, w[1].x0)).collect::<Vec<_>>())
         .collect();
     let crossing = |table: &ShapeTable, points: &[Vec2], label: &str| {
         for r in 0..table.rows() {
@@ -229,35 +181,16 @@ fn splits_conserve_mass_and_momentum_and_reproduction() {
     let top = (ny - 1) as Real * H;
     let xc = 10.0 * H;
     // an oblique band (slope 0.4) through the thickness
-    set_field(&mut m, |x| {
-        0.6 * (-((x.x - xc - 0.4 * (top - x.y)) / H).powi(2)).exp()
-    });
+    set_field(&mut m, |x| 0.6 * (-((x.x - xc - 0.4 * (top - x.y)) / H).powi(2)).exp());
     let mut g = CrackGrowth::new(params(Criterion::EffectiveStrain));
     drive(&mut m, &mut g, 30);
-    assert_eq!(
-        g.cracks.len(),
-        1,
-        "one crack (the other surface is within the exclusion distance)"
-    );
+    assert_eq!(g.cracks.len(), 1, "one crack (the other surface is within the exclusion distance)");
     let c = &g.cracks[0];
-    assert!(
-        c.arrested.is_some(),
-        "the crack runs through and arrests: {:?}",
-        g.events
-    );
+    assert!(c.arrested.is_some(), "the crack runs through and arrests: {:?}", g.events);
     let first = c.vertices[0].x0;
     let last_split = c.vertices[c.vertices.len() - 2].x0;
-    assert!(
-        (first.y - last_split.y).abs() > (ny - 1) as Real * H - 1e-12,
-        "through the thickness"
-    );
-    assert!(
-        g.events
-            .iter()
-            .filter(|e| e.kind == EventKind::Propagate)
-            .count()
-            >= 3
-    );
+    assert!((first.y - last_split.y).abs() > (ny - 1) as Real * H - 1e-12, "through the thickness");
+    assert!(g.events.iter().filter(|e| e.kind == EventKind::Propagate).count() >= 3);
     // every split particle and its sibling carry the crack-face flag and are slaves
     for e in &g.events {
         for &i in &e.particles[..2] {
@@ -286,23 +219,15 @@ fn arrest_at_the_far_surface_without_running_along_it() {
     // start at the top where the band begins, pointing down the band
     let (i0, j0) = (4, ny - 1);
     let start = [id(&m, i0, j0), id(&m, i0 + 1, j0 - 1)];
-    g.insert_crack(&mut m, &start, false)
-        .unwrap();
+    g.insert_crack(&mut m, &start, false).unwrap();
     drive(&mut m, &mut g, 40);
     let c = &g.cracks[0];
     assert!(c.arrested.is_some(), "arrested: {:?}", g.events);
     let n = c.vertices.len();
     let at_surface = c.vertices[n - 2].x0;
-    assert!(
-        at_surface.y.abs() < 1e-12,
-        "stopped on the far surface: {at_surface:?}"
-    );
+    assert!(at_surface.y.abs() < 1e-12, "stopped on the far surface: {at_surface:?}");
     // no vertex before the arrival runs along the bottom
-    assert!(
-        c.vertices[..n - 2].iter().all(|v| v.x0.y > 0.5 * H),
-        "ran along the surface: {:?}",
-        c.vertices
-    );
+    assert!(c.vertices[..n - 2].iter().all(|v| v.x0.y > 0.5 * H), "ran along the surface: {:?}", c.vertices);
     // the end point is just outside the surface, below the arrival point
     assert!(c.vertices[n - 1].x0.y < 0.0 && c.vertices[n - 1].x0.y > -0.05 * H);
     // and nothing happens to it afterwards
@@ -318,13 +243,7 @@ fn shape_function_ahead_of_the_tip_is_cut_in_two() {
     // top down the middle column
     let path_of = |m: &Model| -> Vec<usize> { (3..ny).rev().map(|j| id(m, xc, j)).collect() };
     let support_of = |m: &Model, i: usize| -> Vec<usize> {
-        (0..m.quad.len())
-            .filter(|&q| {
-                m.qp_shape
-                    .range(q)
-                    .any(|k| m.qp_shape.index[k] as usize == i)
-            })
-            .collect()
+        (0..m.quad.len()).filter(|&q| m.qp_shape.range(q).any(|k| m.qp_shape.index[k] as usize == i)).collect()
     };
     let x_mid = xc as Real * H;
     // crack down to row 6; particle k = (xc, 5) is just ahead of the tip
@@ -335,46 +254,24 @@ fn shape_function_ahead_of_the_tip_is_cut_in_two() {
     ga.insert_crack(&mut a, &path[..5], false).unwrap();
     assert_eq!(ga.cracks[0].tip, Some(k_tip));
     let before = support_of(&a, k);
-    assert!(
-        before.iter().any(|&q| a.quad.x0[q].x < x_mid)
-            && before.iter().any(|&q| a.quad.x0[q].x > x_mid)
-    );
+    assert!(before.iter().any(|&q| a.quad.x0[q].x < x_mid) && before.iter().any(|&q| a.quad.x0[q].x > x_mid));
     // the crack passes k (two more particles)
     let mut b = plate(nx, ny);
     let mut gb = CrackGrowth::new(params(Criterion::None));
     let inv = snapshot(&b);
     gb.insert_crack(&mut b, &path[..7], false).unwrap();
     check_invariants(&b, &gb, &inv, "crack past k");
-    let ev = gb
-        .events
-        .iter()
-        .find(|e| e.particles[0] == k)
-        .expect("k was split");
+    let ev = gb.events.iter().find(|e| e.particles[0] == k).expect("k was split");
     let (kl, kr) = (ev.particles[0], ev.particles[1]);
     let (sl, sr) = (support_of(&b, kl), support_of(&b, kr));
     assert!(!sl.is_empty() && !sr.is_empty());
     // growing downward, the left of the path is +x
-    assert!(
-        sl.iter().all(|&q| b.quad.x0[q].x > x_mid),
-        "left child lives on the left"
-    );
-    assert!(
-        sr.iter().all(|&q| b.quad.x0[q].x < x_mid),
-        "right child lives on the right"
-    );
-    let covered = before
-        .iter()
-        .filter(|q| sl.contains(q) || sr.contains(q))
-        .count();
-    assert!(
-        covered as Real >= 0.95 * before.len() as Real,
-        "{covered} of {}",
-        before.len()
-    );
+    assert!(sl.iter().all(|&q| b.quad.x0[q].x > x_mid), "left child lives on the left");
+    assert!(sr.iter().all(|&q| b.quad.x0[q].x < x_mid), "right child lives on the right");
+    let covered = before.iter().filter(|q| sl.contains(q) || sr.contains(q)).count();
+    assert!(covered as Real >= 0.95 * before.len() as Real, "{covered} of {}", before.len());
     // the halves carry the parent's volume
-    assert!(
-        (b.particles.volume[kl] + b.particles.volume[kr] - a.particles.volume[k]).abs() < 1e-15
-    );
+    assert!((b.particles.volume[kl] + b.particles.volume[kr] - a.particles.volume[k]).abs() < 1e-15);
 }
 
 /// An edge crack halfway across a plate pulled apart: the normal stress at
@@ -415,20 +312,11 @@ fn crack_faces_are_traction_free_under_tension() {
     let (intact, near) = run(false);
     let (cracked, near_c) = run(true);
     assert_eq!(near, near_c);
-    let mean =
-        |m: &Model| near.iter().map(|&q| sigma_yy(m, q).abs()).sum::<Real>() / near.len() as Real;
+    let mean = |m: &Model| near.iter().map(|&q| sigma_yy(m, q).abs()).sum::<Real>() / near.len() as Real;
     let (s_intact, s_cracked) = (mean(&intact), mean(&cracked));
-    eprintln!(
-        "mean |sigma_yy| next to the faces: intact {s_intact:.3e} Pa, cracked {s_cracked:.3e} Pa"
-    );
-    assert!(
-        s_intact > 50e6,
-        "the intact plate carries the load: {s_intact:e} Pa"
-    );
-    assert!(
-        s_cracked < 0.15 * s_intact,
-        "faces traction-free: {s_cracked:e} vs {s_intact:e} Pa"
-    );
+    eprintln!("mean |sigma_yy| next to the faces: intact {s_intact:.3e} Pa, cracked {s_cracked:.3e} Pa");
+    assert!(s_intact > 50e6, "the intact plate carries the load: {s_intact:e} Pa");
+    assert!(s_cracked < 0.15 * s_intact, "faces traction-free: {s_cracked:e} vs {s_intact:e} Pa");
 }
 
 const SMALL_IMPACT: &str = r#"
@@ -478,10 +366,7 @@ fn end_to_end_cracks_start_at_the_projectile_corners() {
     let mut sides = [false, false];
     for c in &g.cracks {
         let p0 = c.vertices[0].x0;
-        assert!(
-            (p0.y - 0.004).abs() < 1e-9,
-            "nucleated on the impact face: {p0:?}"
-        );
+        assert!((p0.y - 0.004).abs() < 1e-9, "nucleated on the impact face: {p0:?}");
         assert!((p0.x.abs() - 0.004).abs() < 1.5e-3, "at a corner: {p0:?}");
         sides[(p0.x > 0.0) as usize] = true;
         assert!(c.vertices.len() >= 3, "propagated: {:?}", c.vertices);
@@ -490,10 +375,7 @@ fn end_to_end_cracks_start_at_the_projectile_corners() {
     let slaves = sim.contact.as_ref().unwrap().slaves.particles().to_vec();
     for e in &g.events {
         for &i in &e.particles[..2] {
-            assert!(
-                slaves.binary_search(&(i as u32)).is_ok(),
-                "crack face {i} is a contact slave"
-            );
+            assert!(slaves.binary_search(&(i as u32)).is_ok(), "crack face {i} is a contact slave");
         }
     }
 }
@@ -502,10 +384,7 @@ fn end_to_end_cracks_start_at_the_projectile_corners() {
 #[test]
 fn crack_paths_do_not_depend_on_the_thread_count() {
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| {
             let sim = small_impact(8e-6);
             let g = sim.cracks.unwrap();
@@ -545,30 +424,13 @@ fn fracture_section_is_validated() {
         "fracture.offset_ratio=0.5".to_string(),
         "fracture.radius_factor=0.5".to_string(),
     ];
-    let err = Case::from_str_with(text, "f.toml", &sets)
-        .unwrap_err()
-        .to_string();
-    for key in [
-        "critical_effective_strain",
-        "fan_angle",
-        "offset_ratio",
-        "radius_factor",
-    ] {
-        assert!(
-            err.contains(&format!("fracture.{key}")),
-            "{key} not reported: {err}"
-        );
+    let err = Case::from_str_with(text, "f.toml", &sets).unwrap_err().to_string();
+    for key in ["critical_effective_strain", "fan_angle", "offset_ratio", "radius_factor"] {
+        assert!(err.contains(&format!("fracture.{key}")), "{key} not reported: {err}");
     }
-    let unknown = Case::from_str_with(text, "f.toml", &["fracture.theta=1.0".to_string()])
-        .unwrap_err()
-        .to_string();
+    let unknown = Case::from_str_with(text, "f.toml", &["fracture.theta=1.0".to_string()]).unwrap_err().to_string();
     assert!(unknown.contains("theta"), "{unknown}");
-    let bad = Case::from_str_with(
-        text,
-        "f.toml",
-        &["fracture.criterion=\"stress\"".to_string()],
-    )
-    .unwrap_err()
-    .to_string();
+    let bad =
+        Case::from_str_with(text, "f.toml", &["fracture.criterion=\"stress\"".to_string()]).unwrap_err().to_string();
     assert!(bad.contains("stress"), "{bad}");
 }

@@ -4,10 +4,10 @@
 //! results, and the analytic hypoelastic Jaumann solution of simple shear.
 
 use nalgebra::{Matrix3, Rotation3, Vector3};
-use plugsim::material_point::{run, DriverConfig, LoadPath, Record};
 use plugsim::material::johnson_cook::{JohnsonCook, RateForm};
 use plugsim::material::library::{weldox_460e, weldox_460e_borvik};
 use plugsim::material::{Constitutive, Elastic, Material, PointState, StepKinematics};
+use plugsim::material_point::{run, DriverConfig, LoadPath, Record};
 
 type M3 = Matrix3<f64>;
 
@@ -46,8 +46,7 @@ fn rhs(p: &JohnsonCook, y: &Y, d: &M3, w: &M3) -> Y {
     let mean = y.tau.trace() / 3.0;
     let s = y.tau - eye * mean;
     let tbar = (1.5 * s.dot(&s)).sqrt();
-    let tstar = ((y.temp - p.room_temperature) / (p.melting_temperature - p.room_temperature))
-        .clamp(0.0, 1.0);
+    let tstar = ((y.temp - p.room_temperature) / (p.melting_temperature - p.room_temperature)).clamp(0.0, 1.0);
     let g = (p.yield_stress + p.hardening_modulus * y.eps.powf(p.hardening_exponent))
         * (1.0 - tstar.powf(p.softening_exponent));
     let ratio = tbar / g;
@@ -57,11 +56,7 @@ fn rhs(p: &JohnsonCook, y: &Y, d: &M3, w: &M3) -> Y {
         RateForm::Power if ratio > 1.0 => p.reference_strain_rate * (ratio.powf(1.0 / c) - 1.0),
         RateForm::Power => 0.0,
     };
-    let nhat = if tbar > 0.0 {
-        s * (1.5 / tbar)
-    } else {
-        M3::zeros()
-    };
+    let nhat = if tbar > 0.0 { s * (1.5 / tbar) } else { M3::zeros() };
     let tdot = p.taylor_quinney * tbar * rate / (p.density * p.specific_heat);
     let dprime = d - eye * (d.trace() / 3.0);
     let taudot = eye * (bulk * d.trace()) + (dprime - nhat * rate) * (2.0 * shear)
@@ -75,18 +70,12 @@ fn rhs(p: &JohnsonCook, y: &Y, d: &M3, w: &M3) -> Y {
         RateForm::Power => (1.0 + rstar).powf(dc.d4),
     };
     let dmg = if tbar > 0.0 {
-        let eps_f =
-            (dc.d1 + dc.d2 * (dc.d3 * mean / tbar).exp()) * rate_term * (1.0 + dc.d5 * tstar);
+        let eps_f = (dc.d1 + dc.d2 * (dc.d3 * mean / tbar).exp()) * rate_term * (1.0 + dc.d5 * tstar);
         rate / eps_f
     } else {
         0.0
     };
-    Y {
-        tau: taudot,
-        eps: rate,
-        temp: tdot,
-        dmg,
-    }
+    Y { tau: taudot, eps: rate, temp: tdot, dmg }
 }
 
 /// RK4 over `[0, t_end]` in `n` steps; returns the states at `t_end·i/marks`,
@@ -94,12 +83,7 @@ fn rhs(p: &JohnsonCook, y: &Y, d: &M3, w: &M3) -> Y {
 fn reference(p: &JohnsonCook, d: &M3, w: &M3, t_end: f64, n: usize, marks: usize) -> Vec<Y> {
     assert_eq!(n % marks, 0);
     let h = t_end / n as f64;
-    let mut y = Y {
-        tau: M3::zeros(),
-        eps: 0.0,
-        temp: p.room_temperature,
-        dmg: 0.0,
-    };
+    let mut y = Y { tau: M3::zeros(), eps: 0.0, temp: p.room_temperature, dmg: 0.0 };
     let mut out = Vec::new();
     for i in 1..=n {
         let k1 = rhs(p, &y, d, w);
@@ -148,13 +132,7 @@ fn path_kinematics(path: LoadPath, r: f64) -> (M3, M3) {
 
 /// Run the driver with `steps` steps and the reference, compare at four
 /// instants; returns the largest relative error of each compared quantity.
-fn driver_vs_reference(
-    m: &JohnsonCook,
-    path: LoadPath,
-    rate: f64,
-    strain: f64,
-    steps: usize,
-) -> [f64; 4] {
+fn driver_vs_reference(m: &JohnsonCook, path: LoadPath, rate: f64, strain: f64, steps: usize) -> [f64; 4] {
     let marks = 4;
     let t_end = strain / rate;
     let config = DriverConfig {
@@ -181,12 +159,7 @@ fn driver_vs_reference(
         let got = compared(&r.tau, r.eps_p, r.temperature, r.damage, t0);
         for q in 0..4 {
             // Guard: the reference itself is converged.
-            assert!(
-                rel(check[q], want[q]) < 1e-6,
-                "reference not converged: {q} {} {}",
-                check[q],
-                want[q]
-            );
+            assert!(rel(check[q], want[q]) < 1e-6, "reference not converged: {q} {} {}", check[q], want[q]);
             worst[q] = worst[q].max(rel(got[q], want[q]));
         }
     }
@@ -194,12 +167,7 @@ fn driver_vs_reference(
 }
 
 fn assert_within(worst: [f64; 4], tol: f64, what: &str) {
-    let names = [
-        "equivalent stress",
-        "plastic strain",
-        "temperature rise",
-        "damage",
-    ];
+    let names = ["equivalent stress", "plastic strain", "temperature rise", "damage"];
     for (name, e) in names.iter().zip(worst) {
         assert!(e < tol, "{what}: {name} relative error {e:.3e}");
     }
@@ -234,8 +202,7 @@ fn power_law_simple_shear_at_1e4_matches_reference_ode() {
 /// uniaxial strain it grows steadily), so its error halves with the step.
 #[test]
 fn damage_error_halves_with_the_step() {
-    let error =
-        |steps| driver_vs_reference(&weldox_460e(), LoadPath::UniaxialStrain, 1e4, 0.2, steps)[3];
+    let error = |steps| driver_vs_reference(&weldox_460e(), LoadPath::UniaxialStrain, 1e4, 0.2, steps)[3];
     let errors = [error(1000), error(2000), error(4000)];
     for pair in errors.windows(2) {
         let order = (pair[0] / pair[1]).log2();
@@ -266,11 +233,7 @@ fn steady_uniaxial_strain_stress(m: &JohnsonCook, rate: f64, temp: f64) -> f64 {
         dt: strain / rate / 3000.0,
         initial_temperature: Some(temp),
     };
-    run(&Material::JohnsonCook(m.clone()), &config)
-        .unwrap()
-        .last()
-        .unwrap()
-        .equivalent_stress
+    run(&Material::JohnsonCook(m.clone()), &config).unwrap().last().unwrap().equivalent_stress
 }
 
 #[test]
@@ -286,11 +249,7 @@ fn rate_sensitivity_follows_the_rate_law() {
                 RateForm::Log => g * (1.0 + c * (plastic_rate / rate0).ln()),
                 RateForm::Power => g * (1.0 + plastic_rate / rate0).powf(c),
             };
-            assert!(
-                rel(got, want) < 1e-6,
-                "{:?} at {plastic_rate}: {got} vs {want}",
-                m.rate_form
-            );
+            assert!(rel(got, want) < 1e-6, "{:?} at {plastic_rate}: {got} vs {want}", m.rate_form);
         }
     }
 }
@@ -326,9 +285,7 @@ fn adiabatic_heating_equals_plastic_work() {
         // ∫ τ̄ dε̄ along the path, trapezoidal rule over the records.
         let work: f64 = r
             .windows(2)
-            .map(|p| {
-                0.5 * (p[0].equivalent_stress + p[1].equivalent_stress) * (p[1].eps_p - p[0].eps_p)
-            })
+            .map(|p| 0.5 * (p[0].equivalent_stress + p[1].equivalent_stress) * (p[1].eps_p - p[0].eps_p))
             .sum();
         let want = m.taylor_quinney * work / (m.density * m.specific_heat);
         let got = r.last().unwrap().temperature - m.room_temperature;
@@ -358,17 +315,10 @@ fn damage_reaches_one_at_the_analytic_failure_strain() {
             initial_temperature: None,
         };
         let r = run(&Material::JohnsonCook(m.clone()), &config).unwrap();
-        let i = r
-            .iter()
-            .position(|x| x.damage >= 1.0)
-            .expect("damage reaches 1");
+        let i = r.iter().position(|x| x.damage >= 1.0).expect("damage reaches 1");
         let (a, b) = (&r[i - 1], &r[i]);
         let at_failure = a.eps_p + (1.0 - a.damage) / (b.damage - a.damage) * (b.eps_p - a.eps_p);
-        assert!(
-            rel(at_failure, eps_f) < 2e-3,
-            "{:?}: {at_failure} vs {eps_f}",
-            m.rate_form
-        );
+        assert!(rel(at_failure, eps_f) < 2e-3, "{:?}: {at_failure} vs {eps_f}", m.rate_form);
     }
 }
 
@@ -379,26 +329,13 @@ fn damage_reaches_one_at_the_analytic_failure_strain() {
 /// Rotate a pre-stressed point rigidly by `angle` about `axis` in `n` steps
 /// (d = 0); returns the largest relative change of `tr τ`, `τ̄` and `det τ`
 /// and the distance to the exactly rotated stress `Q τ₀ Qᵀ`.
-fn rigid_rotation_errors(
-    m: &Material,
-    tau0: &M3,
-    axis: &Vector3<f64>,
-    angle: f64,
-    n: usize,
-) -> (f64, f64) {
+fn rigid_rotation_errors(m: &Material, tau0: &M3, axis: &Vector3<f64>, angle: f64, n: usize) -> (f64, f64) {
     let omega = 1e3;
     let u = axis.normalize();
     let w = u.cross_matrix() * omega;
     let dt = angle / omega / n as f64;
-    let k = StepKinematics {
-        d: M3::zeros(),
-        w,
-        dt,
-    };
-    let mut s = PointState {
-        tau: *tau0,
-        ..PointState::at_rest(m.initial_temperature())
-    };
+    let k = StepKinematics { d: M3::zeros(), w, dt };
+    let mut s = PointState { tau: *tau0, ..PointState::at_rest(m.initial_temperature()) };
     for _ in 0..n {
         s = m.update(&s, &k);
     }
@@ -425,15 +362,9 @@ fn rigid_rotation_leaves_stress_invariants_unchanged() {
         room_temperature: 293.0,
         thermal: None,
     });
-    for m in [
-        Material::JohnsonCook(jc.clone()),
-        Material::JohnsonCook(weldox_460e_borvik()),
-        elastic,
-    ] {
-        let (inv_1, rot_1) =
-            rigid_rotation_errors(&m, &tau0, &axis, std::f64::consts::FRAC_PI_2, 4000);
-        let (inv_2, rot_2) =
-            rigid_rotation_errors(&m, &tau0, &axis, std::f64::consts::FRAC_PI_2, 8000);
+    for m in [Material::JohnsonCook(jc.clone()), Material::JohnsonCook(weldox_460e_borvik()), elastic] {
+        let (inv_1, rot_1) = rigid_rotation_errors(&m, &tau0, &axis, std::f64::consts::FRAC_PI_2, 4000);
+        let (inv_2, rot_2) = rigid_rotation_errors(&m, &tau0, &axis, std::f64::consts::FRAC_PI_2, 8000);
         assert!(inv_1 < 2e-3 && rot_1 < 2e-3, "{inv_1} {rot_1}");
         // The explicit Jaumann update is first order: halving the step halves the drift.
         assert!((inv_1 / inv_2 - 2.0).abs() < 0.1, "order {}", inv_1 / inv_2);
@@ -444,13 +375,8 @@ fn rigid_rotation_leaves_stress_invariants_unchanged() {
 /// Hypoelastic simple shear with the Jaumann rate: `τ_xy = G sin γ`,
 /// `τ_xx = −τ_yy = G (1 − cos γ)` — the well-known spurious oscillation.
 fn elastic_shear_error(dgamma: f64) -> f64 {
-    let e = Elastic {
-        density: 7850.0,
-        youngs_modulus: 200e9,
-        poisson_ratio: 0.3,
-        room_temperature: 293.0,
-        thermal: None,
-    };
+    let e =
+        Elastic { density: 7850.0, youngs_modulus: 200e9, poisson_ratio: 0.3, room_temperature: 293.0, thermal: None };
     let g = e.shear_modulus();
     let gamma_end = 2.0 * std::f64::consts::PI;
     let config = DriverConfig {
@@ -462,15 +388,8 @@ fn elastic_shear_error(dgamma: f64) -> f64 {
     };
     let r = run(&Material::Elastic(e), &config).unwrap();
     // The oscillation is there: τ_xy changes sign past γ = π.
-    let at = |gamma: f64| {
-        r.iter()
-            .min_by(|a, b| {
-                (a.strain - gamma)
-                    .abs()
-                    .total_cmp(&(b.strain - gamma).abs())
-            })
-            .unwrap()
-    };
+    let at =
+        |gamma: f64| r.iter().min_by(|a, b| (a.strain - gamma).abs().total_cmp(&(b.strain - gamma).abs())).unwrap();
     assert!(at(1.5 * std::f64::consts::PI).tau[(0, 1)] < -0.9 * g);
     r.iter()
         .map(|x| {
@@ -498,13 +417,8 @@ fn elastic_simple_shear_follows_the_jaumann_solution() {
 fn simple_shear_at_1e7_with_the_paper_step_is_smooth() {
     let m = weldox_460e();
     let run_with = |dt: f64| {
-        let config = DriverConfig {
-            path: LoadPath::SimpleShear,
-            rate: 1e7,
-            final_strain: 2.0,
-            dt,
-            initial_temperature: None,
-        };
+        let config =
+            DriverConfig { path: LoadPath::SimpleShear, rate: 1e7, final_strain: 2.0, dt, initial_temperature: None };
         run(&Material::JohnsonCook(m.clone()), &config).unwrap()
     };
     let coarse = run_with(4e-9);
@@ -521,17 +435,9 @@ fn simple_shear_at_1e7_with_the_paper_step_is_smooth() {
         );
         // The unresolved first step (0 → 8 × yield strain) heats ~1.7 K
         // less; the offset stays small against the total rise.
-        assert!(
-            (c.temperature - f.temperature).abs() < 0.02 * rise,
-            "{i}: {} vs {}",
-            c.temperature,
-            f.temperature
-        );
+        assert!((c.temperature - f.temperature).abs() < 0.02 * rise, "{i}: {} vs {}", c.temperature, f.temperature);
         // No swapping of the normal stresses from step to step.
-        assert!(
-            (c.tau[(0, 0)] - c.tau[(1, 1)]).abs() < 0.05 * c.equivalent_stress,
-            "{i}"
-        );
+        assert!((c.tau[(0, 0)] - c.tau[(1, 1)]).abs() < 0.05 * c.equivalent_stress, "{i}");
     }
 }
 
@@ -546,37 +452,19 @@ fn adiabatic_softening_runs_up_to_melting() {
     // rate is proportional to the vanishing strength).
     let mut m = weldox_460e();
     m.melting_temperature = 450.0;
-    let config = DriverConfig {
-        path: LoadPath::SimpleShear,
-        rate: 1e4,
-        final_strain: 4.0,
-        dt: 1e-7,
-        initial_temperature: None,
-    };
+    let config =
+        DriverConfig { path: LoadPath::SimpleShear, rate: 1e4, final_strain: 4.0, dt: 1e-7, initial_temperature: None };
     let r = run(&Material::JohnsonCook(m.clone()), &config).unwrap();
-    let (peak_at, peak) = r
-        .iter()
-        .map(|x| x.equivalent_stress)
-        .enumerate()
-        .fold((0, 0.0), |a, (i, v)| if v > a.1 { (i, v) } else { a });
+    let (peak_at, peak) =
+        r.iter().map(|x| x.equivalent_stress).enumerate().fold((0, 0.0), |a, (i, v)| if v > a.1 { (i, v) } else { a });
     assert!(peak > 0.8 * m.yield_stress);
     let last = r.last().unwrap();
-    assert!(
-        last.equivalent_stress < 0.2 * peak,
-        "{}",
-        last.equivalent_stress
-    );
+    assert!(last.equivalent_stress < 0.2 * peak, "{}", last.equivalent_stress);
     // Falls monotonically, up to the O(Δt) jump where the update switches to
     // the radial return (τ̄ < 3GΔt ε̇, Deviation 11; 2e-4 here).
-    assert!(r[peak_at..]
-        .windows(2)
-        .all(|p| p[1].equivalent_stress <= p[0].equivalent_stress * (1.0 + 1e-3)));
-    assert!(r
-        .windows(2)
-        .all(|p| p[1].temperature >= p[0].temperature && p[1].eps_p >= p[0].eps_p));
-    assert!(
-        last.temperature > m.melting_temperature - 20.0 && last.temperature < m.melting_temperature
-    );
+    assert!(r[peak_at..].windows(2).all(|p| p[1].equivalent_stress <= p[0].equivalent_stress * (1.0 + 1e-3)));
+    assert!(r.windows(2).all(|p| p[1].temperature >= p[0].temperature && p[1].eps_p >= p[0].eps_p));
+    assert!(last.temperature > m.melting_temperature - 20.0 && last.temperature < m.melting_temperature);
 }
 
 #[test]
@@ -604,26 +492,12 @@ fn melted_point_flows_like_a_fluid_through_the_driver() {
 #[test]
 fn virgin_point_yields_under_every_path_and_law() {
     for m in [weldox_460e(), weldox_460e_borvik()] {
-        for path in [
-            LoadPath::UniaxialStrain,
-            LoadPath::UniaxialStress,
-            LoadPath::SimpleShear,
-        ] {
-            let config = DriverConfig {
-                path,
-                rate: 1e3,
-                final_strain: 0.05,
-                dt: 1e-7,
-                initial_temperature: None,
-            };
+        for path in [LoadPath::UniaxialStrain, LoadPath::UniaxialStress, LoadPath::SimpleShear] {
+            let config = DriverConfig { path, rate: 1e3, final_strain: 0.05, dt: 1e-7, initial_temperature: None };
             let r = run(&Material::JohnsonCook(m.clone()), &config).unwrap();
             let last = r.last().unwrap();
             assert!(last.eps_p > 0.01, "{:?} {path:?}", m.rate_form);
-            assert!(
-                last.equivalent_stress < 1.5 * m.yield_stress,
-                "{:?} {path:?}",
-                m.rate_form
-            );
+            assert!(last.equivalent_stress < 1.5 * m.yield_stress, "{:?} {path:?}", m.rate_form);
         }
     }
 }

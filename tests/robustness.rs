@@ -20,10 +20,7 @@ fn scratch(name: &str) -> PathBuf {
 }
 
 fn plugsim(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_plugsim"))
-        .args(args)
-        .output()
-        .unwrap()
+    Command::new(env!("CARGO_BIN_EXE_plugsim")).args(args).output().unwrap()
 }
 
 /// The run failed, without a panic, with exactly one line on stderr; returns it.
@@ -46,10 +43,7 @@ fn refused(case_file: &Path, extra: &[&str], name: &str) -> String {
     let out_dir = scratch(&format!("{name}-run")).join("out");
     let out = out_dir.display().to_string();
     let run = one_error_line(&plugsim(&[&["run", &case, "--out", &out], extra].concat()));
-    assert!(
-        !out_dir.exists(),
-        "a refused run leaves no output directory: {run}"
-    );
+    assert!(!out_dir.exists(), "a refused run leaves no output directory: {run}");
     check
 }
 
@@ -65,42 +59,26 @@ const STRIKE: &str = include_str!("../cases/elastic-strike.toml");
 fn malformed_toml_names_file_and_line() {
     let path = write_case("malformed", "title = \"x\"\n[geometry\nmode = ");
     let line = refused(&path, &[], "malformed");
-    assert!(
-        line.contains(&path.display().to_string()) && line.contains("line 2"),
-        "{line}"
-    );
+    assert!(line.contains(&path.display().to_string()) && line.contains("line 2"), "{line}");
 }
 
 #[test]
 fn wrong_type_names_the_key() {
-    let path = write_case(
-        "wrong-type",
-        &STRIKE.replace("layers = 12 ", "layers = \"twelve\" "),
-    );
+    let path = write_case("wrong-type", &STRIKE.replace("layers = 12 ", "layers = \"twelve\" "));
     let line = refused(&path, &[], "wrong-type");
     assert!(line.contains("layers") && line.contains("twelve"), "{line}");
-    let line = refused(
-        &write_case("wrong-type-2", STRIKE),
-        &["--set", "time.end=soon"],
-        "wrong-type-2",
-    );
+    let line = refused(&write_case("wrong-type-2", STRIKE), &["--set", "time.end=soon"], "wrong-type-2");
     assert!(line.contains("time.end") && line.contains("soon"), "{line}");
 }
 
 #[test]
 fn absurd_discretization_is_refused_up_front_with_the_estimate() {
     let path = write_case("absurd", STRIKE);
-    for set in [
-        "bodies.plate.rectangle.layers=2000000",
-        "bodies.plate.rectangle.fine_spacing=1e-300",
-    ] {
+    for set in ["bodies.plate.rectangle.layers=2000000", "bodies.plate.rectangle.fine_spacing=1e-300"] {
         let t = std::time::Instant::now();
         let line = refused(&path, &["--set", set], "absurd");
         assert!(t.elapsed().as_secs_f64() < 10.0, "refused fast");
-        assert!(
-            line.contains("memory") && line.contains("particles") && line.contains("available"),
-            "{line}"
-        );
+        assert!(line.contains("memory") && line.contains("particles") && line.contains("available"), "{line}");
     }
 }
 
@@ -108,39 +86,22 @@ fn absurd_discretization_is_refused_up_front_with_the_estimate() {
 fn absurd_step_count_and_snapshot_count_are_refused() {
     let path = write_case("steps", STRIKE);
     let line = refused(&path, &["--set", "time.fixed_dt=1e-20"], "steps");
-    assert!(
-        line.contains("time step") && line.contains("steps"),
-        "{line}"
-    );
+    assert!(line.contains("time step") && line.contains("steps"), "{line}");
     let line = refused(&path, &["--set", "output.interval=1e-15"], "snapshots");
-    assert!(
-        line.contains("output.interval") && line.contains("snapshots"),
-        "{line}"
-    );
+    assert!(line.contains("output.interval") && line.contains("snapshots"), "{line}");
     // moduli so large that the wave speed overflows: the step would be zero
     let line = refused(
         &path,
-        &[
-            "--set",
-            "materials.steel.youngs_modulus=1e308",
-            "--set",
-            "materials.steel.density=1e-300",
-        ],
+        &["--set", "materials.steel.youngs_modulus=1e308", "--set", "materials.steel.density=1e-300"],
         "zero-dt",
     );
-    assert!(
-        line.contains("time step") && line.contains("positive"),
-        "{line}"
-    );
+    assert!(line.contains("time step") && line.contains("positive"), "{line}");
 }
 
 #[test]
 fn unreadable_case_path_is_named() {
     let line = one_error_line(&plugsim(&["check", "/nonexistent/case.toml"]));
-    assert!(
-        line.contains("/nonexistent/case.toml") && line.contains("cannot read"),
-        "{line}"
-    );
+    assert!(line.contains("/nonexistent/case.toml") && line.contains("cannot read"), "{line}");
     let dir = scratch("case-is-dir");
     let line = one_error_line(&plugsim(&["check", &dir.display().to_string()]));
     assert!(line.contains("cannot read"), "{line}");
@@ -152,44 +113,23 @@ fn unwritable_output_path_is_named_and_nothing_is_left() {
     let blocker = dir.join("a-file");
     std::fs::write(&blocker, b"not a directory").unwrap();
     for out in [blocker.join("run"), blocker.clone()] {
-        let line = one_error_line(&plugsim(&[
-            "run",
-            "--case",
-            "elastic-strike",
-            "--out",
-            &out.display().to_string(),
-        ]));
-        assert!(
-            line.contains("output directory") && line.contains(&out.display().to_string()),
-            "{line}"
-        );
+        let line = one_error_line(&plugsim(&["run", "--case", "elastic-strike", "--out", &out.display().to_string()]));
+        assert!(line.contains("output directory") && line.contains(&out.display().to_string()), "{line}");
     }
     assert_eq!(std::fs::read(&blocker).unwrap(), b"not a directory");
 }
 
 #[test]
 fn unknown_material_and_body_are_named() {
-    let path = write_case(
-        "unknown-material",
-        &STRIKE.replace("material = \"steel\"", "material = \"unobtainium\""),
-    );
+    let path = write_case("unknown-material", &STRIKE.replace("material = \"steel\"", "material = \"unobtainium\""));
     let line = refused(&path, &[], "unknown-material");
     assert!(
-        line.contains("bodies[0].material")
-            && line.contains("unobtainium")
-            && line.contains("weldox_460e"),
+        line.contains("bodies[0].material") && line.contains("unobtainium") && line.contains("weldox_460e"),
         "{line}"
     );
     let path = write_case("unknown-body", STRIKE);
-    let line = refused(
-        &path,
-        &["--set", "bodies.anvil.material=steel"],
-        "unknown-body",
-    );
-    assert!(
-        line.contains("bodies.anvil.material") && line.contains("no element named 'anvil'"),
-        "{line}"
-    );
+    let line = refused(&path, &["--set", "bodies.anvil.material=steel"], "unknown-body");
+    assert!(line.contains("bodies.anvil.material") && line.contains("no element named 'anvil'"), "{line}");
 }
 
 /// A fixed step about twice the stable one: the run must stop with the
@@ -216,35 +156,17 @@ fn unstable_fixed_dt_stops_with_a_message() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");
-    assert!(
-        stderr.contains("energy blow-up in step") && stderr.contains("(t = "),
-        "{stderr}"
-    );
-    assert!(
-        stderr.contains("likely cause")
-            && stderr.contains("fixed_dt")
-            && stderr.contains("particle"),
-        "{stderr}"
-    );
+    assert!(stderr.contains("energy blow-up in step") && stderr.contains("(t = "), "{stderr}");
+    assert!(stderr.contains("likely cause") && stderr.contains("fixed_dt") && stderr.contains("particle"), "{stderr}");
     // earlier output intact: every snapshot the series names exists and parses
     let pvd = std::fs::read_to_string(dir.join("results.pvd")).unwrap();
-    let files: Vec<&str> = pvd
-        .split("file=\"")
-        .skip(1)
-        .map(|s| &s[..s.find('"').unwrap()])
-        .collect();
+    let files: Vec<&str> = pvd.split("file=\"").skip(1).map(|s| &s[..s.find('"').unwrap()]).collect();
     assert!(files.len() >= 3, "{pvd}");
     for f in &files {
         let text = std::fs::read(dir.join(f)).unwrap();
-        assert!(
-            text.starts_with(b"<?xml") || text.starts_with(b"<VTKFile"),
-            "{f}"
-        );
+        assert!(text.starts_with(b"<?xml") || text.starts_with(b"<VTKFile"), "{f}");
     }
-    assert!(
-        stderr.contains(files.last().unwrap()),
-        "the message names the last snapshot: {stderr}"
-    );
+    assert!(stderr.contains(files.last().unwrap()), "the message names the last snapshot: {stderr}");
     let history = plugsim::io::HistoryTable::read(&dir.join("history.csv")).unwrap();
     let steps = history.column("step").unwrap();
     assert!(steps.windows(2).all(|w| w[1] == w[0] + 1.0), "{steps:?}");
@@ -276,36 +198,21 @@ fn a_driven_punch_is_not_an_energy_blow_up() {
     .iter()
     .map(|s| s.to_string())
     .collect();
-    let case = Case::from_str_with(
-        include_str!("../cases/borvik-1-nofracture.toml"),
-        "punch.toml",
-        &overrides,
-    )
-    .unwrap();
+    let case =
+        Case::from_str_with(include_str!("../cases/borvik-1-nofracture.toml"), "punch.toml", &overrides).unwrap();
     let dir = scratch("punch").join("out");
     let mut last = None;
-    execute(
-        &case,
-        &RunConfig::new(dir, true, RunInfo::current("punch", &[])),
-        &mut |p| {
-            if let Progress::Finished { sim } = p {
-                last = Some(sim.clone());
-            }
-        },
-    )
+    execute(&case, &RunConfig::new(dir, true, RunInfo::current("punch", &[])), &mut |p| {
+        if let Progress::Finished { sim } = p {
+            last = Some(sim.clone());
+        }
+    })
     .unwrap_or_else(|e| panic!("{e}"));
     let sim = last.unwrap();
     let e = sim.energies;
-    assert!(
-        e.total() > 2.0 * e.initial_kinetic,
-        "the driver put in more than the punch's kinetic energy: {e:?}"
-    );
+    assert!(e.total() > 2.0 * e.initial_kinetic, "the driver put in more than the punch's kinetic energy: {e:?}");
     let input = sim.input_energy();
-    assert!(
-        (e.total() - input).abs() < 0.05 * input,
-        "balance {} J against input {input} J",
-        e.total()
-    );
+    assert!((e.total() - input).abs() < 0.05 * input, "balance {} J against input {input} J", e.total());
 }
 
 // ------------------------------------------------------------------ fuzz
@@ -368,24 +275,11 @@ enum TextEdit {
 
 fn value() -> impl Strategy<Value = toml::Value> {
     use toml::Value as V;
-    let special = vec![
-        f64::NAN,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        1e300,
-        -1e300,
-        0.0,
-        -0.0,
-        1e-300,
-        -1.0,
-        1e9,
-        0.5,
-    ];
+    let special = vec![f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e300, -1e300, 0.0, -0.0, 1e-300, -1.0, 1e9, 0.5];
     prop_oneof![
         prop::sample::select(special.clone()).prop_map(V::Float),
         any::<f64>().prop_map(V::Float),
-        prop::sample::select(vec![0i64, -1, 1, 2, 5, 1_000_000_000, i64::MAX, i64::MIN])
-            .prop_map(V::Integer),
+        prop::sample::select(vec![0i64, -1, 1, 2, 5, 1_000_000_000, i64::MAX, i64::MIN]).prop_map(V::Integer),
         any::<i64>().prop_map(V::Integer),
         "\\PC{0,12}".prop_map(V::String),
         prop::sample::select(vec![
@@ -410,21 +304,7 @@ fn value() -> impl Strategy<Value = toml::Value> {
 }
 
 fn edit() -> impl Strategy<Value = Edit> {
-    let factors = vec![
-        0.0,
-        -1.0,
-        1e-300,
-        1e300,
-        1e-6,
-        1e6,
-        10.0,
-        0.1,
-        0.999,
-        1.001,
-        f64::NAN,
-        f64::INFINITY,
-        -0.0,
-    ];
+    let factors = vec![0.0, -1.0, 1e-300, 1e300, 1e-6, 1e6, 10.0, 0.1, 0.999, 1.001, f64::NAN, f64::INFINITY, -0.0];
     let ints = vec![0i64, 1, 2, 3, -1, 1000, 1_000_000_000, i64::MAX, i64::MIN];
     let names = "(plate|steel|weldox_460e|disc|projectile|all|x|y|log|power|\\PC{0,8})";
     prop_oneof![
@@ -456,13 +336,9 @@ fn base_cases() -> Vec<toml::Value> {
     )]) {
         let v: toml::Value = toml::from_str(text).unwrap();
         let mut small = v.clone();
-        if let Some(toml::Value::Array(bodies)) = get_mut(&mut small, &[Seg::Key("bodies".into())])
-        {
+        if let Some(toml::Value::Array(bodies)) = get_mut(&mut small, &[Seg::Key("bodies".into())]) {
             for b in bodies {
-                if let Some(layers) = get_mut(
-                    b,
-                    &[Seg::Key("rectangle".into()), Seg::Key("layers".into())],
-                ) {
+                if let Some(layers) = get_mut(b, &[Seg::Key("rectangle".into()), Seg::Key("layers".into())]) {
                     *layers = toml::Value::Integer(4);
                 }
             }
@@ -509,12 +385,7 @@ fn check_like_the_cli(text: &str, overrides: &[String]) {
         match plugsim::run::build_simulation(&resolved) {
             Ok(sim) => {
                 assert!(sim.dt.is_finite() && sim.dt > 0.0);
-                assert!(sim
-                    .model
-                    .particles
-                    .mass
-                    .iter()
-                    .all(|m| m.is_finite() && *m > 0.0));
+                assert!(sim.model.particles.mass.iter().all(|m| m.is_finite() && *m > 0.0));
             }
             Err(e) => {
                 let _ = e.to_string();

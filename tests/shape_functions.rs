@@ -63,7 +63,9 @@ fn reproduces(growth: Real) {
     for pts in [&b.quad_points, &b.particles] {
         let t = build_table(pts, &b.particles, &b.support, &b.volume, &AllVisible).unwrap();
         let worst = check_reproduction(&t, pts, &b.particles, 0.06);
-        for (c, name) in ["sum N", "sum N X", "sum N XY", "sum grad N", "sum grad N (x) X", "grad of XY"].iter().enumerate() {
+        for (c, name) in
+            ["sum N", "sum N X", "sum N XY", "sum grad N", "sum grad N (x) X", "grad of XY"].iter().enumerate()
+        {
             assert!(worst[c] < 1e-12, "{name}: {:e} (growth {growth})", worst[c]);
         }
     }

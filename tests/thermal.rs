@@ -38,10 +38,7 @@ fn conductor(kappa: Real) -> Material {
         youngs_modulus: 1e9,
         poisson_ratio: 0.3,
         room_temperature: 300.0,
-        thermal: Some(ThermalProperties {
-            specific_heat: CP,
-            conductivity: kappa,
-        }),
+        thermal: Some(ThermalProperties { specific_heat: CP, conductivity: kappa }),
     })
 }
 
@@ -67,8 +64,7 @@ fn erfc(x: Real) -> Real {
                 + t * (0.09678418
                     + t * (-0.18628806
                         + t * (0.27886807
-                            + t * (-1.13520398
-                                + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277))))))));
+                            + t * (-1.13520398 + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277))))))));
     let r = t * p.exp();
     if x >= 0.0 {
         r
@@ -89,48 +85,31 @@ fn erfc_matches_reference_values() {
         (3.0, 2.209049699858544e-5),
         (-1.0, 1.8427007929497148),
     ] {
-        assert!(
-            (erfc(x) - want).abs() <= 1.2e-7 * want,
-            "erfc({x}) = {} vs {want}",
-            erfc(x)
-        );
+        assert!((erfc(x) - want).abs() <= 1.2e-7 * want, "erfc({x}) = {} vs {want}", erfc(x));
     }
 }
 
 /// Deterministic pseudo-random numbers in [0, 1).
 fn lcg(s: &mut u64) -> Real {
-    *s = s
-        .wrapping_mul(6364136223846793005)
-        .wrapping_add(1442695040888963407);
+    *s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
     (*s >> 11) as Real / (1u64 << 53) as Real
 }
 
 /// `Σ_q ρ₀ C_p w_q T_q`: the heat content of the quadrature points, J.
 fn quad_heat(m: &Model) -> Real {
-    m.quad
-        .weight
-        .iter()
-        .zip(&m.quad.temperature)
-        .map(|(w, t)| RHO * CP * w * t)
-        .sum()
+    m.quad.weight.iter().zip(&m.quad.temperature).map(|(w, t)| RHO * CP * w * t).sum()
 }
 
 /// `Σ_I c_I T_I` over the particles.
 fn particle_heat(m: &Model, heat: &HeatConduction) -> Real {
-    (0..m.particles.len())
-        .map(|i| heat.capacity(m, i).unwrap() * m.particles.temperature[i])
-        .sum()
+    (0..m.particles.len()).map(|i| heat.capacity(m, i).unwrap() * m.particles.temperature[i]).sum()
 }
 
 /// Physical temperature at the particles, `T(X_I) = Σ_J N_J(X_I) T_J`.
 fn physical_temperature(m: &Model) -> Vec<Real> {
     let tab = &m.particle_shape;
     (0..m.particles.len())
-        .map(|i| {
-            tab.range(i)
-                .map(|k| tab.value[k] * m.particles.temperature[tab.index[k] as usize])
-                .sum()
-        })
+        .map(|i| tab.range(i).map(|k| tab.value[k] * m.particles.temperature[tab.index[k] as usize]).sum())
         .collect()
 }
 
@@ -148,11 +127,7 @@ fn temperature_step_in_a_bar_follows_erfc() {
     let (t0, t1) = (300.0, 400.0);
     let kappa = 1e6; // α = 1 m²/s
     let alpha = kappa / (RHO * CP);
-    let mut m = model(
-        GeometryMode::PlaneStrain,
-        grid((-0.2, 0.2), (0.0, 4.0 * h), h),
-        kappa,
-    );
+    let mut m = model(GeometryMode::PlaneStrain, grid((-0.2, 0.2), (0.0, 4.0 * h), h), kappa);
     for q in 0..m.quad.len() {
         m.quad.temperature[q] = if m.quad.x0[q].x < 0.0 { t1 } else { t0 };
     }
@@ -161,15 +136,9 @@ fn temperature_step_in_a_bar_follows_erfc() {
     let calls = 20;
     let mut substeps = 0;
     for _ in 0..calls {
-        substeps += heat
-            .conduct(&mut m, t_end / calls as Real)
-            .unwrap()
-            .substeps;
+        substeps += heat.conduct(&mut m, t_end / calls as Real).unwrap().substeps;
     }
-    assert!(
-        substeps > calls,
-        "the test must exercise sub-cycling ({substeps} sub-steps)"
-    );
+    assert!(substeps > calls, "the test must exercise sub-cycling ({substeps} sub-steps)");
     let exact = |x: Real| t0 + 0.5 * (t1 - t0) * erfc(x / (2.0 * (alpha * t_end).sqrt()));
     let step = t1 - t0;
     let phys = physical_temperature(&m);
@@ -183,11 +152,7 @@ fn temperature_step_in_a_bar_follows_erfc() {
         }
     }
     assert!(checked > 200);
-    assert!(
-        worst < 0.02,
-        "particle field: worst error {:.3} % of the step",
-        100.0 * worst
-    );
+    assert!(worst < 0.02, "particle field: worst error {:.3} % of the step", 100.0 * worst);
     // The quadrature points keep the sub-particle part of the initial jump
     // (only increments are interpolated back, SPEC §7); beyond two supports
     // from it they follow the same solution.
@@ -198,11 +163,7 @@ fn temperature_step_in_a_bar_follows_erfc() {
             worst_q = worst_q.max((m.quad.temperature[q] - exact(x)).abs() / step);
         }
     }
-    assert!(
-        worst_q < 0.02,
-        "quadrature points: worst error {:.3} % of the step",
-        100.0 * worst_q
-    );
+    assert!(worst_q < 0.02, "quadrature points: worst error {:.3} % of the step", 100.0 * worst_q);
     // the far ends have not felt it yet
     for q in 0..m.quad.len() {
         if m.quad.x0[q].x.abs() > 0.19 {
@@ -223,13 +184,9 @@ fn closed_body_conserves_heat_over_many_substeps() {
     graded.growth = 1.2;
     graded.coarse_spacing = Some(3e-3);
     graded.fine_half_width = 0.004;
-    for (mode, g) in [
-        (GeometryMode::PlaneStrain, graded),
-        (
-            GeometryMode::Axisymmetric,
-            grid((0.0, 0.012), (0.0, 0.006), 1e-3),
-        ),
-    ] {
+    for (mode, g) in
+        [(GeometryMode::PlaneStrain, graded), (GeometryMode::Axisymmetric, grid((0.0, 0.012), (0.0, 0.006), 1e-3))]
+    {
         let mut m = model(mode, g, 50.0);
         let mut s = 11u64;
         for t in m.quad.temperature.iter_mut() {
@@ -246,10 +203,7 @@ fn closed_body_conserves_heat_over_many_substeps() {
             let p0 = particle_heat(&m, &heat);
             substeps += heat.conduct(&mut m, dt).unwrap().substeps;
             let p1 = particle_heat(&m, &heat);
-            assert!(
-                (p1 - p0).abs() <= 1e-13 * p0.abs(),
-                "{mode:?}: particle heat {p0} -> {p1}"
-            );
+            assert!((p1 - p0).abs() <= 1e-13 * p0.abs(), "{mode:?}: particle heat {p0} -> {p1}");
             moved += m
                 .quad
                 .temperature
@@ -261,22 +215,12 @@ fn closed_body_conserves_heat_over_many_substeps() {
         }
         assert!(substeps >= 1000, "{substeps}");
         let e1 = quad_heat(&m);
-        assert!(
-            (e1 - e0).abs() <= 1e-12 * e0.abs(),
-            "{mode:?}: heat {e0} -> {e1}, rel {:.2e}",
-            (e1 - e0) / e0
-        );
+        assert!((e1 - e0).abs() <= 1e-12 * e0.abs(), "{mode:?}: heat {e0} -> {e1}, rel {:.2e}", (e1 - e0) / e0);
         // and relative to the heat that actually moved, not just to the total
-        assert!(
-            (e1 - e0).abs() <= 1e-11 * moved,
-            "{mode:?}: imbalance {:.3e} J vs {moved:.3e} J moved",
-            e1 - e0
-        );
+        assert!((e1 - e0).abs() <= 1e-11 * moved, "{mode:?}: imbalance {:.3e} J vs {moved:.3e} J moved", e1 - e0);
         // it did move: the field relaxed towards its mean
-        let spread = |t: &[Real]| {
-            t.iter().cloned().fold(Real::MIN, Real::max)
-                - t.iter().cloned().fold(Real::MAX, Real::min)
-        };
+        let spread =
+            |t: &[Real]| t.iter().cloned().fold(Real::MIN, Real::max) - t.iter().cloned().fold(Real::MAX, Real::min);
         assert!(spread(&m.particles.temperature) < 0.5 * 500.0);
     }
 }
@@ -287,39 +231,24 @@ fn closed_body_conserves_heat_over_many_substeps() {
 /// the particle temperatures never grows.
 #[test]
 fn sub_cycling_keeps_large_steps_stable_and_relaxes_to_the_mean() {
-    let mut m = model(
-        GeometryMode::PlaneStrain,
-        grid((0.0, 0.01), (0.0, 0.004), 1e-3),
-        50.0,
-    );
+    let mut m = model(GeometryMode::PlaneStrain, grid((0.0, 0.01), (0.0, 0.004), 1e-3), 50.0);
     let mut s = 5u64;
     for t in m.quad.temperature.iter_mut() {
         *t = 300.0 + 200.0 * lcg(&mut s);
     }
     let mut heat = HeatConduction::new(&m, DEFAULT_SAFETY_FACTOR).unwrap();
     let stable = heat.stable_time_step(&mut m).unwrap();
-    let c: Vec<Real> = (0..m.particles.len())
-        .map(|i| heat.capacity(&m, i).unwrap())
-        .collect();
+    let c: Vec<Real> = (0..m.particles.len()).map(|i| heat.capacity(&m, i).unwrap()).collect();
     let mean = particle_heat(&m, &heat) / c.iter().sum::<Real>();
-    let spread = |m: &Model| -> Real {
-        m.particles
-            .temperature
-            .iter()
-            .zip(&c)
-            .map(|(t, c)| c * (t - mean).powi(2))
-            .sum()
-    };
+    let spread =
+        |m: &Model| -> Real { m.particles.temperature.iter().zip(&c).map(|(t, c)| c * (t - mean).powi(2)).sum() };
     let first = spread(&m);
     let mut last = first;
     for _ in 0..10 {
         let r = heat.conduct(&mut m, 10.0 * stable).unwrap();
         assert_eq!(r.substeps, 10);
         let now = spread(&m);
-        assert!(
-            now < last,
-            "C-weighted spread did not decrease: {last:.4e} -> {now:.4e}"
-        );
+        assert!(now < last, "C-weighted spread did not decrease: {last:.4e} -> {now:.4e}");
         last = now;
     }
     assert!(last < 0.5 * first);
@@ -327,10 +256,7 @@ fn sub_cycling_keeps_large_steps_stable_and_relaxes_to_the_mean() {
     let r = heat.conduct(&mut m, 40.0).unwrap();
     assert!(r.substeps > 10_000, "{}", r.substeps);
     for (i, t) in m.particles.temperature.iter().enumerate() {
-        assert!(
-            (t - mean).abs() < 1e-6 * 200.0,
-            "particle {i}: {t} vs mean {mean}"
-        );
+        assert!((t - mean).abs() < 1e-6 * 200.0, "particle {i}: {t} vs mean {mean}");
     }
 }
 
@@ -349,16 +275,8 @@ fn uniform_temperature_stays_uniform() {
         let mut heat = HeatConduction::new(&m, DEFAULT_SAFETY_FACTOR).unwrap();
         let dt = 200.0 * heat.stable_time_step(&mut m).unwrap();
         heat.conduct(&mut m, dt).unwrap();
-        let worst = m
-            .quad
-            .temperature
-            .iter()
-            .map(|x| (x - t).abs())
-            .fold(0.0, Real::max);
-        assert!(
-            worst < 1e-9,
-            "{mode:?}: uniform field drifted by {worst:.3e} K"
-        );
+        let worst = m.quad.temperature.iter().map(|x| (x - t).abs()).fold(0.0, Real::max);
+        assert!(worst < 1e-9, "{mode:?}: uniform field drifted by {worst:.3e} K");
     }
 }
 
@@ -371,11 +289,7 @@ fn uniform_temperature_stays_uniform() {
 fn linear_field_is_steady_inside_but_not_at_insulated_ends() {
     let h = 1e-3;
     let (lx, ly) = (0.03, 0.012);
-    let mut m = model(
-        GeometryMode::PlaneStrain,
-        grid((0.0, lx), (0.0, ly), h),
-        50.0,
-    );
+    let mut m = model(GeometryMode::PlaneStrain, grid((0.0, lx), (0.0, ly), h), 50.0);
     let grad = 1000.0; // K/m
     for q in 0..m.quad.len() {
         m.quad.temperature[q] = 300.0 + grad * m.quad.x0[q].x;
@@ -400,10 +314,7 @@ fn linear_field_is_steady_inside_but_not_at_insulated_ends() {
             hot_end = hot_end.min(-d);
         }
     }
-    assert!(
-        cold_end > 0.0 && hot_end > 0.0,
-        "ends: cold {cold_end:.3e}, hot {hot_end:.3e} (both must be > 0)"
-    );
+    assert!(cold_end > 0.0 && hot_end > 0.0, "ends: cold {cold_end:.3e}, hot {hot_end:.3e} (both must be > 0)");
     assert!(
         interior < 1e-3 * cold_end.min(hot_end),
         "interior change {interior:.3e} K vs ends {cold_end:.3e} / {hot_end:.3e} K"
@@ -421,10 +332,7 @@ fn axisymmetric_r_squared_heats_at_four_alpha() {
     let alpha = kappa / (RHO * CP);
     let b = 1e6; // K/m²
     let (r0, r1, z1) = (0.01, 0.04, 0.02);
-    for (mode, factor) in [
-        (GeometryMode::Axisymmetric, 4.0),
-        (GeometryMode::PlaneStrain, 2.0),
-    ] {
+    for (mode, factor) in [(GeometryMode::Axisymmetric, 4.0), (GeometryMode::PlaneStrain, 2.0)] {
         let mut m = model(mode, grid((r0, r1), (0.0, z1), h), kappa);
         for q in 0..m.quad.len() {
             m.quad.temperature[q] = b * m.quad.x0[q].x.powi(2);
@@ -440,10 +348,7 @@ fn axisymmetric_r_squared_heats_at_four_alpha() {
             let margin = (x.x - r0).min(r1 - x.x).min(x.y).min(z1 - x.y);
             if margin > 5.0 * h {
                 let rate = (t - t_before) / dt;
-                assert!(
-                    (rate - want).abs() < 0.01 * want,
-                    "{mode:?} at {x:?}: rate {rate:.4e} vs {want:.4e}"
-                );
+                assert!((rate - want).abs() < 0.01 * want, "{mode:?} at {x:?}: rate {rate:.4e} vs {want:.4e}");
                 n += 1;
             }
         }
@@ -455,10 +360,7 @@ fn axisymmetric_r_squared_heats_at_four_alpha() {
 #[test]
 fn one_and_two_threads_give_identical_temperatures() {
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| {
             let mut g = grid((0.0, 0.03), (0.0, 0.006), 1e-3);
             g.growth = 1.1;
@@ -478,14 +380,8 @@ fn one_and_two_threads_give_identical_temperatures() {
     };
     let (q1, p1) = run(1);
     let (q2, p2) = run(2);
-    assert!(
-        q1.iter().zip(&q2).all(|(a, b)| a.to_bits() == b.to_bits()),
-        "quadrature temperatures differ"
-    );
-    assert!(
-        p1.iter().zip(&p2).all(|(a, b)| a.to_bits() == b.to_bits()),
-        "particle temperatures differ"
-    );
+    assert!(q1.iter().zip(&q2).all(|(a, b)| a.to_bits() == b.to_bits()), "quadrature temperatures differ");
+    assert!(p1.iter().zip(&p2).all(|(a, b)| a.to_bits() == b.to_bits()), "particle temperatures differ");
 }
 
 /// A small Johnson–Cook plate (power rate law: a true elastic range) whose
@@ -551,16 +447,10 @@ fn heat_section_switches_conduction() {
     assert!(off.heat.is_none());
     let q = &off.model.quad;
     let hottest = q.temperature.iter().cloned().fold(0.0, Real::max);
-    assert!(
-        hottest > t0 + 1.0,
-        "the case must heat adiabatically (max {hottest} K)"
-    );
+    assert!(hottest > t0 + 1.0, "the case must heat adiabatically (max {hottest} K)");
     let elastic: Vec<usize> = (0..q.len()).filter(|&k| q.eps_p[k] == 0.0).collect();
     assert!(elastic.len() > q.len() / 4);
-    assert!(
-        elastic.iter().all(|&k| q.temperature[k] == t0),
-        "adiabatic: elastic points stay at room temperature"
-    );
+    assert!(elastic.iter().all(|&k| q.temperature[k] == t0), "adiabatic: elastic points stay at room temperature");
 
     for text in ["[heat]\nconduction = true", ""] {
         let case = struck(text);
@@ -568,20 +458,11 @@ fn heat_section_switches_conduction() {
         let on = run(&case);
         assert!(on.heat.is_some());
         let q = &on.model.quad;
-        let warmed = (0..q.len())
-            .filter(|&k| q.eps_p[k] == 0.0 && q.temperature[k] > t0 + 1e-3)
-            .count();
+        let warmed = (0..q.len()).filter(|&k| q.eps_p[k] == 0.0 && q.temperature[k] > t0 + 1e-3).count();
         assert!(warmed > 0, "{text:?}: no elastic point received heat");
         let hottest_on = q.temperature.iter().cloned().fold(0.0, Real::max);
-        assert!(
-            hottest_on < hottest,
-            "{text:?}: conduction must lower the peak ({hottest_on} vs {hottest})"
-        );
-        assert!(on
-            .timers
-            .list()
-            .iter()
-            .any(|(name, _)| *name == "heat conduction"));
+        assert!(hottest_on < hottest, "{text:?}: conduction must lower the peak ({hottest_on} vs {hottest})");
+        assert!(on.timers.list().iter().any(|(name, _)| *name == "heat conduction"));
     }
 }
 
@@ -607,11 +488,7 @@ HEAT
 end = 1.0e-6
 "#;
     let case = |extra: &str, heat: &str| {
-        Case::from_str_with(
-            &elastic.replace("EXTRA", extra).replace("HEAT", heat),
-            "pane.toml",
-            &[],
-        )
+        Case::from_str_with(&elastic.replace("EXTRA", extra).replace("HEAT", heat), "pane.toml", &[])
     };
     // no thermal properties: off by default, and the resolved case says so
     let c = case("", "").unwrap();
@@ -623,23 +500,15 @@ end = 1.0e-6
     assert!(c.heat_conduction());
     assert!(build_simulation(&c.resolved()).unwrap().heat.is_some());
     // explicitly on without them: a problem naming heat.conduction and the body
-    let e = case("specific_heat = 800.0", "[heat]\nconduction = true")
-        .unwrap_err()
-        .to_string();
+    let e = case("specific_heat = 800.0", "[heat]\nconduction = true").unwrap_err().to_string();
     assert!(e.contains("heat.conduction") && e.contains("pane"), "{e}");
-    let e = case("", "[heat]\nsafety_factor = 1.5")
-        .unwrap_err()
-        .to_string();
+    let e = case("", "[heat]\nsafety_factor = 1.5").unwrap_err().to_string();
     assert!(e.contains("heat.safety_factor"), "{e}");
-    let e = case("", "[heat]\nconduktion = true")
-        .unwrap_err()
-        .to_string();
+    let e = case("", "[heat]\nconduktion = true").unwrap_err().to_string();
     assert!(e.contains("conduktion"), "{e}");
     // --set works on the section
     let c = Case::from_str_with(
-        &elastic
-            .replace("EXTRA", "specific_heat = 800.0\nthermal_conductivity = 1.0")
-            .replace("HEAT", ""),
+        &elastic.replace("EXTRA", "specific_heat = 800.0\nthermal_conductivity = 1.0").replace("HEAT", ""),
         "pane.toml",
         &["heat.conduction=false".into()],
     )

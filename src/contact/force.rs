@@ -158,11 +158,7 @@ mod tests {
     fn inverse_distance_weights_sum_to_one_and_floor_the_slave() {
         let mut w = vec![(9, 0.25)];
         let xs = Vec2::new(0.0, 0.0);
-        let cands = [
-            (3u32, xs),
-            (4, Vec2::new(1.0, 0.0)),
-            (5, Vec2::new(0.0, -2.0)),
-        ];
+        let cands = [(3u32, xs), (4, Vec2::new(1.0, 0.0)), (5, Vec2::new(0.0, -2.0))];
         inverse_distance_weights(&xs, 0.5, cands, &mut w);
         let total: Real = w[1..].iter().map(|e| e.1).sum();
         assert!((total - 1.0).abs() < 1e-15 && w[0] == (9, 0.25));

@@ -41,9 +41,7 @@ impl PointGrid {
     /// finite (callers validate their inputs first and map this to their own
     /// error).
     pub fn new(points: &[Vec2], cell: Real) -> Option<Self> {
-        if !(cell.is_finite() && cell > 0.0)
-            || points.iter().any(|p| !p.iter().all(|c| c.is_finite()))
-        {
+        if !(cell.is_finite() && cell > 0.0) || points.iter().any(|p| !p.iter().all(|c| c.is_finite())) {
             return None;
         }
         let (mut lo, mut hi) = (Vec2::zeros(), Vec2::zeros());
@@ -134,10 +132,7 @@ impl PointGrid {
     fn visit_box(&self, x0: usize, x1: usize, y0: usize, y1: usize, mut f: impl FnMut(usize)) {
         for iy in y0..=y1 {
             let row = iy * self.nx;
-            let (a, b) = (
-                self.start[row + x0] as usize,
-                self.start[row + x1 + 1] as usize,
-            );
+            let (a, b) = (self.start[row + x0] as usize, self.start[row + x1 + 1] as usize);
             for &i in &self.items[a..b] {
                 f(i as usize);
             }
@@ -267,19 +262,13 @@ mod tests {
         let mut s = 42u64;
         for trial in 0..200 {
             let n = 1 + (splitmix(&mut s) * 300.0) as usize;
-            let pts: Vec<Vec2> = (0..n)
-                .map(|_| Vec2::new(splitmix(&mut s), 3.0 * splitmix(&mut s)))
-                .collect();
+            let pts: Vec<Vec2> = (0..n).map(|_| Vec2::new(splitmix(&mut s), 3.0 * splitmix(&mut s))).collect();
             let cell = 0.01 + 0.5 * splitmix(&mut s);
             let g = PointGrid::new(&pts, cell).unwrap();
             for _ in 0..50 {
                 // queries inside and well outside the bounding box
                 let q = Vec2::new(4.0 * splitmix(&mut s) - 1.5, 9.0 * splitmix(&mut s) - 3.0);
-                assert_eq!(
-                    g.nearest(&q),
-                    nearest_brute_force(&pts, &q),
-                    "trial {trial}, q = {q:?}"
-                );
+                assert_eq!(g.nearest(&q), nearest_brute_force(&pts, &q), "trial {trial}, q = {q:?}");
             }
         }
     }
@@ -287,9 +276,7 @@ mod tests {
     #[test]
     fn nearest_breaks_ties_by_smallest_index() {
         // a regular lattice queried at cell centres: four equidistant points
-        let pts: Vec<Vec2> = (0..100)
-            .map(|k| Vec2::new((k % 10) as Real, (k / 10) as Real))
-            .collect();
+        let pts: Vec<Vec2> = (0..100).map(|k| Vec2::new((k % 10) as Real, (k / 10) as Real)).collect();
         let g = PointGrid::new(&pts, 1.0).unwrap();
         for k in 0..81 {
             let q = Vec2::new((k % 9) as Real + 0.5, (k / 9) as Real + 0.5);
@@ -300,9 +287,7 @@ mod tests {
     #[test]
     fn within_matches_brute_force() {
         let mut s = 7u64;
-        let pts: Vec<Vec2> = (0..500)
-            .map(|_| Vec2::new(splitmix(&mut s), splitmix(&mut s)))
-            .collect();
+        let pts: Vec<Vec2> = (0..500).map(|_| Vec2::new(splitmix(&mut s), splitmix(&mut s))).collect();
         let g = PointGrid::new(&pts, 0.05).unwrap();
         for _ in 0..100 {
             let q = Vec2::new(1.2 * splitmix(&mut s) - 0.1, 1.2 * splitmix(&mut s) - 0.1);
@@ -310,9 +295,7 @@ mod tests {
             let mut got = Vec::new();
             g.for_each_within(&q, r, |i, _| got.push(i));
             got.sort_unstable();
-            let want: Vec<usize> = (0..pts.len())
-                .filter(|&i| (pts[i] - q).norm_squared() < r * r)
-                .collect();
+            let want: Vec<usize> = (0..pts.len()).filter(|&i| (pts[i] - q).norm_squared() < r * r).collect();
             assert_eq!(got, want);
         }
     }

@@ -69,8 +69,7 @@ pub use search::{search_rigid_polygon, search_rigid_polygon_brute_force, Project
 pub use slave::{MasterFeature, Pairing, SlaveSet};
 pub use surface::{detect_surface, SurfaceDetection};
 pub use system::{
-    ActiveContact, BodySample, ContactAccumulators, ContactParameters, ContactSystem, StepInput,
-    StepReport,
+    ActiveContact, BodySample, ContactAccumulators, ContactParameters, ContactSystem, StepInput, StepReport,
 };
 
 use crate::math::Real;
@@ -89,17 +88,9 @@ pub enum ContactError {
     #[error("parameter `{name}` = {value} is out of range")]
     InvalidParameter { name: &'static str, value: Real },
     #[error("particle {particle}: invalid {field} = {value}")]
-    InvalidParticle {
-        particle: usize,
-        field: &'static str,
-        value: Real,
-    },
+    InvalidParticle { particle: usize, field: &'static str, value: Real },
     #[error("`{field}` has {found} entries, expected {expected}")]
-    LengthMismatch {
-        field: &'static str,
-        expected: usize,
-        found: usize,
-    },
+    LengthMismatch { field: &'static str, expected: usize, found: usize },
     #[error("slave particle {particle} does not exist ({particles} particles)")]
     SlaveOutOfRange { particle: usize, particles: usize },
     #[error("not a permutation: entry {position} repeats or exceeds the length")]
@@ -109,18 +100,11 @@ pub enum ContactError {
     #[error("shape table is malformed (offsets not monotone from 0, or entry arrays of different lengths)")]
     InvalidShapeTable,
     #[error("shape table row {row} names particle {particle} ({particles} particles)")]
-    ShapeIndexOutOfRange {
-        row: usize,
-        particle: usize,
-        particles: usize,
-    },
+    ShapeIndexOutOfRange { row: usize, particle: usize, particles: usize },
     #[error("shape functions at particle {particle} sum to {sum}, not 1")]
     PartitionOfUnity { particle: usize, sum: Real },
     #[error("particle {particle}: {quantity} is not finite")]
-    NonFinite {
-        particle: usize,
-        quantity: &'static str,
-    },
+    NonFinite { particle: usize, quantity: &'static str },
     #[error("ContactSystem::advance called without a preceding compute_forces")]
     AdvanceWithoutForces,
 }

@@ -86,15 +86,9 @@ impl RigidBody {
             lower = lower.inf(v);
             upper = upper.sup(v);
         }
-        let perimeter: Real = (0..n)
-            .map(|k| (outline[(k + 1) % n] - outline[k]).norm())
-            .sum();
-        let grid = PointGrid::new(&outline, perimeter / n as Real).ok_or_else(|| {
-            ContactError::InvalidOutline {
-                body: name.clone(),
-                reason: "vertex grid".into(),
-            }
-        })?;
+        let perimeter: Real = (0..n).map(|k| (outline[(k + 1) % n] - outline[k]).norm()).sum();
+        let grid = PointGrid::new(&outline, perimeter / n as Real)
+            .ok_or_else(|| ContactError::InvalidOutline { body: name.clone(), reason: "vertex grid".into() })?;
         Ok(Self {
             name,
             outline,
@@ -190,21 +184,14 @@ impl RigidBody {
 /// Its nose (the face at `y = −height/2`) is segment 0.
 pub fn rectangle_outline(width: Real, height: Real) -> Vec<Vec2> {
     let (a, b) = (0.5 * width, 0.5 * height);
-    vec![
-        Vec2::new(-a, -b),
-        Vec2::new(a, -b),
-        Vec2::new(a, b),
-        Vec2::new(-a, b),
-    ]
+    vec![Vec2::new(-a, -b), Vec2::new(a, -b), Vec2::new(a, b), Vec2::new(-a, b)]
 }
 
 /// Signed area of a closed polygon (shoelace), m²; positive when
 /// counter-clockwise.
 pub fn polygon_signed_area(outline: &[Vec2]) -> Real {
     let n = outline.len();
-    0.5 * (0..n)
-        .map(|k| outline[k].perp(&outline[(k + 1) % n]))
-        .sum::<Real>()
+    0.5 * (0..n).map(|k| outline[k].perp(&outline[(k + 1) % n])).sum::<Real>()
 }
 
 /// Mass per unit depth of a plane-strain section, `ρ A`, kg/m (SPEC §10:
@@ -239,9 +226,7 @@ pub fn mass_axisymmetric(outline: &[Vec2], density: Real) -> Result<Real, Contac
         / 6.0;
     let volume = 2.0 * std::f64::consts::PI * moment.abs();
     if !(volume.is_finite() && volume > 0.0) {
-        return Err(ContactError::EmptyBody {
-            area: polygon_signed_area(&half).abs(),
-        });
+        return Err(ContactError::EmptyBody { area: polygon_signed_area(&half).abs() });
     }
     Ok(density * volume)
 }
@@ -250,10 +235,7 @@ fn check_density(density: Real) -> Result<(), ContactError> {
     if density.is_finite() && density > 0.0 {
         Ok(())
     } else {
-        Err(ContactError::InvalidParameter {
-            name: "density",
-            value: density,
-        })
+        Err(ContactError::InvalidParameter { name: "density", value: density })
     }
 }
 
@@ -277,18 +259,12 @@ fn clip_to_right_half_plane(outline: &[Vec2]) -> Vec<Vec2> {
 
 /// Check that an outline is a simple counter-clockwise polygon.
 fn validate_outline(name: &str, outline: &[Vec2]) -> Result<(), ContactError> {
-    let bad = |reason: String| ContactError::InvalidOutline {
-        body: name.to_string(),
-        reason,
-    };
+    let bad = |reason: String| ContactError::InvalidOutline { body: name.to_string(), reason };
     let n = outline.len();
     if n < 3 {
         return Err(bad(format!("{n} vertices, at least 3 needed")));
     }
-    if let Some(k) = outline
-        .iter()
-        .position(|v| !v.iter().all(|c| c.is_finite()))
-    {
+    if let Some(k) = outline.iter().position(|v| !v.iter().all(|c| c.is_finite())) {
         return Err(bad(format!("vertex {k} is not finite")));
     }
     for k in 0..n {
@@ -298,9 +274,7 @@ fn validate_outline(name: &str, outline: &[Vec2]) -> Result<(), ContactError> {
     }
     let area = polygon_signed_area(outline);
     if area.is_nan() || area <= 0.0 {
-        return Err(bad(format!(
-            "signed area {area:e} m² is not positive: vertices must run counter-clockwise"
-        )));
+        return Err(bad(format!("signed area {area:e} m² is not positive: vertices must run counter-clockwise")));
     }
     // O(n²) pairwise test of non-adjacent segments: done once per body.
     for i in 0..n {
@@ -308,12 +282,7 @@ fn validate_outline(name: &str, outline: &[Vec2]) -> Result<(), ContactError> {
             if i == 0 && j == n - 1 {
                 continue; // adjacent through the closing vertex
             }
-            if segments_intersect(
-                outline[i],
-                outline[(i + 1) % n],
-                outline[j],
-                outline[(j + 1) % n],
-            ) {
+            if segments_intersect(outline[i], outline[(i + 1) % n], outline[j], outline[(j + 1) % n]) {
                 return Err(bad(format!("segments {i} and {j} intersect")));
             }
         }
@@ -328,15 +297,10 @@ fn segments_intersect(a: Vec2, b: Vec2, c: Vec2, d: Vec2) -> bool {
         r.x >= p.x.min(q.x) && r.x <= p.x.max(q.x) && r.y >= p.y.min(q.y) && r.y <= p.y.max(q.y)
     };
     let (d1, d2, d3, d4) = (o(c, d, a), o(c, d, b), o(a, b, c), o(a, b, d));
-    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
-        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
-    {
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0)) && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0)) {
         return true;
     }
-    (d1 == 0.0 && on(c, d, a))
-        || (d2 == 0.0 && on(c, d, b))
-        || (d3 == 0.0 && on(a, b, c))
-        || (d4 == 0.0 && on(a, b, d))
+    (d1 == 0.0 && on(c, d, a)) || (d2 == 0.0 && on(c, d, b)) || (d3 == 0.0 && on(a, b, c)) || (d4 == 0.0 && on(a, b, d))
 }
 
 #[cfg(test)]
@@ -345,14 +309,7 @@ mod tests {
 
     #[test]
     fn rectangle_normals_point_outward() {
-        let b = RigidBody::new(
-            "p",
-            rectangle_outline(2.0, 4.0),
-            Vec2::zeros(),
-            Vec2::zeros(),
-            1.0,
-        )
-        .unwrap();
+        let b = RigidBody::new("p", rectangle_outline(2.0, 4.0), Vec2::zeros(), Vec2::zeros(), 1.0).unwrap();
         assert_eq!(b.segment_normal(0), Vec2::new(0.0, -1.0)); // nose
         assert_eq!(b.segment_normal(1), Vec2::new(1.0, 0.0));
         assert_eq!(b.segment_normal(2), Vec2::new(0.0, 1.0));
@@ -365,18 +322,8 @@ mod tests {
     #[test]
     fn invalid_outlines_are_errors() {
         let cw: Vec<Vec2> = rectangle_outline(1.0, 1.0).into_iter().rev().collect();
-        let bowtie = vec![
-            Vec2::new(0.0, 0.0),
-            Vec2::new(1.0, 1.0),
-            Vec2::new(1.0, 0.0),
-            Vec2::new(0.0, 1.0),
-        ];
-        let dup = vec![
-            Vec2::new(0.0, 0.0),
-            Vec2::new(0.0, 0.0),
-            Vec2::new(1.0, 0.0),
-            Vec2::new(0.0, 1.0),
-        ];
+        let bowtie = vec![Vec2::new(0.0, 0.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0)];
+        let dup = vec![Vec2::new(0.0, 0.0), Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0)];
         for o in [cw, bowtie, dup, vec![Vec2::zeros(), Vec2::new(1.0, 0.0)]] {
             assert!(matches!(
                 RigidBody::new("x", o, Vec2::zeros(), Vec2::zeros(), 1.0),
@@ -384,27 +331,14 @@ mod tests {
             ));
         }
         assert!(matches!(
-            RigidBody::new(
-                "x",
-                rectangle_outline(1.0, 1.0),
-                Vec2::zeros(),
-                Vec2::zeros(),
-                0.0
-            ),
+            RigidBody::new("x", rectangle_outline(1.0, 1.0), Vec2::zeros(), Vec2::zeros(), 0.0),
             Err(ContactError::InvalidBodyMass { .. })
         ));
     }
 
     #[test]
     fn advance_is_central_difference_and_prescribed_overrides() {
-        let mut b = RigidBody::new(
-            "p",
-            rectangle_outline(1.0, 1.0),
-            Vec2::zeros(),
-            Vec2::new(1.0, 0.0),
-            2.0,
-        )
-        .unwrap();
+        let mut b = RigidBody::new("p", rectangle_outline(1.0, 1.0), Vec2::zeros(), Vec2::new(1.0, 0.0), 2.0).unwrap();
         b.advance(Vec2::new(4.0, -2.0), 0.5);
         assert_eq!(b.velocity, Vec2::new(2.0, -0.5));
         assert_eq!(b.position, Vec2::new(1.0, -0.25));

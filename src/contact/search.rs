@@ -88,11 +88,7 @@ fn takes(lambda: Real) -> bool {
 
 #[inline]
 fn segment(body: &RigidBody, k: usize, gap: Real) -> Projection {
-    Projection {
-        feature: MasterFeature::Segment(k as u32),
-        gap,
-        normal: body.segment_normal(k),
-    }
+    Projection { feature: MasterFeature::Segment(k as u32), gap, normal: body.segment_normal(k) }
 }
 
 /// Fine stage: choose between the two segments at vertex `v` (module doc);
@@ -116,11 +112,7 @@ fn select_at_vertex(body: &RigidBody, at: &Vec2, v: usize, x: &Vec2, from: &Vec2
         (false, false) => {
             let normal = body.vertex_normal(v);
             let gap = (x - (at + body.outline()[v])).dot(&normal);
-            Projection {
-                feature: MasterFeature::Vertex(v as u32),
-                gap,
-                normal,
-            }
+            Projection { feature: MasterFeature::Vertex(v as u32), gap, normal }
         }
     }
 }
@@ -153,10 +145,7 @@ fn entry_prefers_first(
         return ta > tb;
     }
     let d = x - from;
-    let (da, db) = (
-        d.dot(&body.segment_normal(ka)),
-        d.dot(&body.segment_normal(kb)),
-    );
+    let (da, db) = (d.dot(&body.segment_normal(ka)), d.dot(&body.segment_normal(kb)));
     if (da - db).abs() > ENTRY_RESOLUTION * d.norm() {
         return da < db;
     }
@@ -167,24 +156,14 @@ fn entry_prefers_first(
 /// vertex from the vertex grid, then the fine rule of the module doc, for
 /// which `from` is the point's start-of-step position relative to the body
 /// placed at `at` (`from = x`: no history, decide by gap alone).
-pub fn search_rigid_polygon(
-    body: &RigidBody,
-    at: &Vec2,
-    x: &Vec2,
-    from: &Vec2,
-) -> Option<Projection> {
+pub fn search_rigid_polygon(body: &RigidBody, at: &Vec2, x: &Vec2, from: &Vec2) -> Option<Projection> {
     let (v, _) = body.vertex_grid().nearest(&(x - at))?;
     Some(select_at_vertex(body, at, v, x, from))
 }
 
 /// Reference for [`search_rigid_polygon`] with the nearest vertex found by an
 /// O(n) loop (ties to the smallest index, as the grid). For tests.
-pub fn search_rigid_polygon_brute_force(
-    body: &RigidBody,
-    at: &Vec2,
-    x: &Vec2,
-    from: &Vec2,
-) -> Option<Projection> {
+pub fn search_rigid_polygon_brute_force(body: &RigidBody, at: &Vec2, x: &Vec2, from: &Vec2) -> Option<Projection> {
     let (v, _) = super::grid::nearest_brute_force(body.outline(), &(x - at))?;
     Some(select_at_vertex(body, at, v, x, from))
 }
@@ -192,12 +171,7 @@ pub fn search_rigid_polygon_brute_force(
 /// Local test of a previous pairing (module doc): the projection on
 /// `feature` if it still holds, `None` if a fresh search is needed.
 /// Test: `penetrating_slave_keeps_the_face_it_crossed`.
-pub fn check_pairing(
-    body: &RigidBody,
-    at: &Vec2,
-    feature: MasterFeature,
-    x: &Vec2,
-) -> Option<Projection> {
+pub fn check_pairing(body: &RigidBody, at: &Vec2, feature: MasterFeature, x: &Vec2) -> Option<Projection> {
     let n = body.vertex_count();
     match feature {
         MasterFeature::Segment(k) => {
@@ -225,84 +199,35 @@ mod tests {
     use crate::contact::rigid::rectangle_outline;
 
     fn rect() -> RigidBody {
-        RigidBody::new(
-            "p",
-            rectangle_outline(20.0, 80.0),
-            Vec2::zeros(),
-            Vec2::zeros(),
-            1.0,
-        )
-        .unwrap()
+        RigidBody::new("p", rectangle_outline(20.0, 80.0), Vec2::zeros(), Vec2::zeros(), 1.0).unwrap()
     }
 
     #[test]
     fn below_the_nose_pairs_with_the_nose() {
         let b = rect();
-        let p = search_rigid_polygon(
-            &b,
-            &Vec2::zeros(),
-            &Vec2::new(3.0, -41.0),
-            &Vec2::new(3.0, -41.0),
-        )
-        .unwrap();
+        let p = search_rigid_polygon(&b, &Vec2::zeros(), &Vec2::new(3.0, -41.0), &Vec2::new(3.0, -41.0)).unwrap();
         assert_eq!(p.feature, MasterFeature::Segment(0));
         assert!((p.gap - 1.0).abs() < 1e-12);
-        let p = search_rigid_polygon(
-            &b,
-            &Vec2::zeros(),
-            &Vec2::new(-9.0, -39.5),
-            &Vec2::new(-9.0, -39.5),
-        )
-        .unwrap();
+        let p = search_rigid_polygon(&b, &Vec2::zeros(), &Vec2::new(-9.0, -39.5), &Vec2::new(-9.0, -39.5)).unwrap();
         assert_eq!(p.feature, MasterFeature::Segment(0));
         assert!((p.gap + 0.5).abs() < 1e-12);
         // inside near the corner but closer to the side: the side
-        let p = search_rigid_polygon(
-            &b,
-            &Vec2::zeros(),
-            &Vec2::new(9.8, -39.0),
-            &Vec2::new(9.8, -39.0),
-        )
-        .unwrap();
+        let p = search_rigid_polygon(&b, &Vec2::zeros(), &Vec2::new(9.8, -39.0), &Vec2::new(9.8, -39.0)).unwrap();
         assert_eq!(p.feature, MasterFeature::Segment(1));
         assert!((p.gap + 0.2).abs() < 1e-12);
         // flush with the side, below the nose: λ = 1 on the nose is accepted
-        let p = search_rigid_polygon(
-            &b,
-            &Vec2::zeros(),
-            &Vec2::new(10.0, -40.5),
-            &Vec2::new(10.0, -40.5),
-        )
-        .unwrap();
+        let p = search_rigid_polygon(&b, &Vec2::zeros(), &Vec2::new(10.0, -40.5), &Vec2::new(10.0, -40.5)).unwrap();
         assert_eq!(p.feature, MasterFeature::Segment(0));
     }
 
     #[test]
     fn vertex_pairing_outside_a_convex_corner() {
         let b = rect();
-        let p = search_rigid_polygon(
-            &b,
-            &Vec2::zeros(),
-            &Vec2::new(11.0, -41.0),
-            &Vec2::new(11.0, -41.0),
-        )
-        .unwrap();
+        let p = search_rigid_polygon(&b, &Vec2::zeros(), &Vec2::new(11.0, -41.0), &Vec2::new(11.0, -41.0)).unwrap();
         assert_eq!(p.feature, MasterFeature::Vertex(1));
         assert!((p.gap - 2.0 / 2f64.sqrt()).abs() < 1e-12);
-        assert!(check_pairing(
-            &b,
-            &Vec2::zeros(),
-            MasterFeature::Vertex(1),
-            &Vec2::new(11.0, -41.0)
-        )
-        .is_some());
-        assert!(check_pairing(
-            &b,
-            &Vec2::zeros(),
-            MasterFeature::Vertex(1),
-            &Vec2::new(9.0, -41.0)
-        )
-        .is_none());
+        assert!(check_pairing(&b, &Vec2::zeros(), MasterFeature::Vertex(1), &Vec2::new(11.0, -41.0)).is_some());
+        assert!(check_pairing(&b, &Vec2::zeros(), MasterFeature::Vertex(1), &Vec2::new(9.0, -41.0)).is_none());
     }
 
     #[test]
@@ -312,37 +237,23 @@ mod tests {
         // abreast of the corner, 0.5 inside through the nose: the fresh rule
         // sees the side at gap 0, the pairing from outside keeps the nose
         let y = Vec2::new(10.0, -39.5);
-        assert_eq!(
-            search_rigid_polygon(&b, &o, &y, &y).unwrap().feature,
-            MasterFeature::Segment(1)
-        );
+        assert_eq!(search_rigid_polygon(&b, &o, &y, &y).unwrap().feature, MasterFeature::Segment(1));
         // the same point found fresh, having come from below the nose: the
         // nose; having come from beside the side face: the side
         let below = Vec2::new(10.0, -40.2);
-        assert_eq!(
-            search_rigid_polygon(&b, &o, &y, &below).unwrap().feature,
-            MasterFeature::Segment(0)
-        );
+        assert_eq!(search_rigid_polygon(&b, &o, &y, &below).unwrap().feature, MasterFeature::Segment(0));
         let beside = Vec2::new(10.2, -38.0);
         let y = Vec2::new(9.9, -39.0);
-        assert_eq!(
-            search_rigid_polygon(&b, &o, &y, &beside).unwrap().feature,
-            MasterFeature::Segment(1)
-        );
+        assert_eq!(search_rigid_polygon(&b, &o, &y, &beside).unwrap().feature, MasterFeature::Segment(1));
         // already inside at the start (no crossing): the motion decides
         let y = Vec2::new(9.5, -39.5);
         let from = Vec2::new(9.5, -39.6);
-        assert_eq!(
-            search_rigid_polygon(&b, &o, &y, &from).unwrap().feature,
-            MasterFeature::Segment(0)
-        );
+        assert_eq!(search_rigid_polygon(&b, &o, &y, &from).unwrap().feature, MasterFeature::Segment(0));
         let p = check_pairing(&b, &o, MasterFeature::Segment(0), &y).unwrap();
         assert_eq!(p.feature, MasterFeature::Segment(0));
         assert!((p.gap + 0.5).abs() < 1e-12);
         // past the end of the segment the pairing is dropped
-        assert!(
-            check_pairing(&b, &o, MasterFeature::Segment(0), &Vec2::new(10.5, -39.5)).is_none()
-        );
+        assert!(check_pairing(&b, &o, MasterFeature::Segment(0), &Vec2::new(10.5, -39.5)).is_none());
         assert!(check_pairing(&b, &o, MasterFeature::Segment(9), &y).is_none());
     }
 }

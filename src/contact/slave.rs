@@ -59,24 +59,16 @@ impl SlaveSet {
 
     /// The particles flagged [`ParticleFlags::SLAVE`].
     pub fn from_flags(flags: &[ParticleFlags]) -> Self {
-        let particles: Vec<u32> = (0..flags.len())
-            .filter(|&i| flags[i].has(ParticleFlags::SLAVE))
-            .map(|i| i as u32)
-            .collect();
+        let particles: Vec<u32> =
+            (0..flags.len()).filter(|&i| flags[i].has(ParticleFlags::SLAVE)).map(|i| i as u32).collect();
         let pairing = vec![None; particles.len()];
         Self { particles, pairing }
     }
 
     /// The surface particles of a particle set, found geometrically
     /// ([`detect_surface`]).
-    pub fn detect(
-        positions: &[Vec2],
-        spacing: &[Real],
-        params: &SurfaceDetection,
-    ) -> Result<Self, ContactError> {
-        Ok(Self::from_indices(detect_surface(
-            positions, spacing, params,
-        )?))
+    pub fn detect(positions: &[Vec2], spacing: &[Real], params: &SurfaceDetection) -> Result<Self, ContactError> {
+        Ok(Self::from_indices(detect_surface(positions, spacing, params)?))
     }
 
     /// Add particle `i` (e.g. a new crack-face particle). Returns `false`
@@ -120,10 +112,7 @@ impl SlaveSet {
 
     /// Last pairing of particle `i`, if it is a slave and was paired.
     pub fn pairing_of_particle(&self, i: usize) -> Option<Pairing> {
-        self.particles
-            .binary_search(&(i as u32))
-            .ok()
-            .and_then(|k| self.pairing[k])
+        self.particles.binary_search(&(i as u32)).ok().and_then(|k| self.pairing[k])
     }
 
     /// Record the pairing of slave `k`.
@@ -156,12 +145,8 @@ impl SlaveSet {
             new_of_old[old] = k as u32;
         }
         self.check_indices(order.len())?;
-        let mut pairs: Vec<(u32, Option<Pairing>)> = self
-            .particles
-            .iter()
-            .zip(&self.pairing)
-            .map(|(&i, &p)| (new_of_old[i as usize], p))
-            .collect();
+        let mut pairs: Vec<(u32, Option<Pairing>)> =
+            self.particles.iter().zip(&self.pairing).map(|(&i, &p)| (new_of_old[i as usize], p)).collect();
         pairs.sort_unstable_by_key(|&(i, _)| i);
         self.particles = pairs.iter().map(|&(i, _)| i).collect();
         self.pairing = pairs.iter().map(|&(_, p)| p).collect();
@@ -171,10 +156,7 @@ impl SlaveSet {
     /// Error if a slave index is not below `n` particles.
     pub fn check_indices(&self, n: usize) -> Result<(), ContactError> {
         match self.particles.last() {
-            Some(&i) if i as usize >= n => Err(ContactError::SlaveOutOfRange {
-                particle: i as usize,
-                particles: n,
-            }),
+            Some(&i) if i as usize >= n => Err(ContactError::SlaveOutOfRange { particle: i as usize, particles: n }),
             _ => Ok(()),
         }
     }
@@ -188,46 +170,22 @@ mod tests {
     fn add_keeps_sorted_unique_and_remembers_pairings() {
         let mut s = SlaveSet::from_indices([5, 1, 3, 1]);
         assert_eq!(s.particles(), &[1, 3, 5]);
-        s.set_pairing(
-            1,
-            Some(Pairing {
-                body: 0,
-                feature: MasterFeature::Segment(2),
-            }),
-        );
+        s.set_pairing(1, Some(Pairing { body: 0, feature: MasterFeature::Segment(2) }));
         assert!(s.add(4));
         assert!(!s.add(3));
         assert_eq!(s.particles(), &[1, 3, 4, 5]);
-        assert_eq!(
-            s.pairing_of_particle(3),
-            Some(Pairing {
-                body: 0,
-                feature: MasterFeature::Segment(2)
-            })
-        );
+        assert_eq!(s.pairing_of_particle(3), Some(Pairing { body: 0, feature: MasterFeature::Segment(2) }));
         assert_eq!(s.pairing_of_particle(4), None);
     }
 
     #[test]
     fn permute_follows_the_particle_store() {
         let mut s = SlaveSet::from_indices([0, 2]);
-        s.set_pairing(
-            1,
-            Some(Pairing {
-                body: 0,
-                feature: MasterFeature::Vertex(1),
-            }),
-        );
+        s.set_pairing(1, Some(Pairing { body: 0, feature: MasterFeature::Vertex(1) }));
         // new 0 = old 2, new 1 = old 0, new 2 = old 1
         s.permute(&[2, 0, 1]).unwrap();
         assert_eq!(s.particles(), &[0, 1]);
-        assert_eq!(
-            s.pairing_of_particle(0),
-            Some(Pairing {
-                body: 0,
-                feature: MasterFeature::Vertex(1)
-            })
-        );
+        assert_eq!(s.pairing_of_particle(0), Some(Pairing { body: 0, feature: MasterFeature::Vertex(1) }));
         assert!(s.permute(&[0, 0, 1]).is_err());
     }
 

@@ -57,10 +57,7 @@ pub struct SurfaceDetection {
 
 impl Default for SurfaceDetection {
     fn default() -> Self {
-        Self {
-            radius_factor: 1.75,
-            min_empty_sector: 2.0 * std::f64::consts::PI / 3.0,
-        }
+        Self { radius_factor: 1.75, min_empty_sector: 2.0 * std::f64::consts::PI / 3.0 }
     }
 }
 
@@ -73,51 +70,28 @@ pub fn detect_surface(
     params: &SurfaceDetection,
 ) -> Result<Vec<usize>, ContactError> {
     if spacing.len() != positions.len() {
-        return Err(ContactError::LengthMismatch {
-            field: "spacing",
-            expected: positions.len(),
-            found: spacing.len(),
-        });
+        return Err(ContactError::LengthMismatch { field: "spacing", expected: positions.len(), found: spacing.len() });
     }
     let c = params.radius_factor;
     if !(c.is_finite() && c > 0.0) {
-        return Err(ContactError::InvalidParameter {
-            name: "radius_factor",
-            value: c,
-        });
+        return Err(ContactError::InvalidParameter { name: "radius_factor", value: c });
     }
     let sector = params.min_empty_sector;
     if !(sector.is_finite() && sector > 0.0 && sector < 2.0 * std::f64::consts::PI) {
-        return Err(ContactError::InvalidParameter {
-            name: "min_empty_sector",
-            value: sector,
-        });
+        return Err(ContactError::InvalidParameter { name: "min_empty_sector", value: sector });
     }
     if let Some(i) = spacing.iter().position(|h| !(h.is_finite() && *h > 0.0)) {
-        return Err(ContactError::InvalidParticle {
-            particle: i,
-            field: "spacing",
-            value: spacing[i],
-        });
+        return Err(ContactError::InvalidParticle { particle: i, field: "spacing", value: spacing[i] });
     }
-    if let Some(i) = positions
-        .iter()
-        .position(|x| !x.iter().all(|c| c.is_finite()))
-    {
-        return Err(ContactError::InvalidParticle {
-            particle: i,
-            field: "position",
-            value: Real::NAN,
-        });
+    if let Some(i) = positions.iter().position(|x| !x.iter().all(|c| c.is_finite())) {
+        return Err(ContactError::InvalidParticle { particle: i, field: "position", value: Real::NAN });
     }
     if positions.is_empty() {
         return Ok(Vec::new());
     }
     let h_max = spacing.iter().cloned().fold(0.0, Real::max);
-    let grid = PointGrid::new(positions, c * h_max).ok_or(ContactError::InvalidParameter {
-        name: "radius_factor",
-        value: c,
-    })?;
+    let grid = PointGrid::new(positions, c * h_max)
+        .ok_or(ContactError::InvalidParameter { name: "radius_factor", value: c })?;
     let mut angles: Vec<Real> = Vec::with_capacity(32);
     let mut surface = Vec::new();
     for (i, xi) in positions.iter().enumerate() {
@@ -167,10 +141,7 @@ mod tests {
         let p = SurfaceDetection::default();
         assert!(detect_surface(&x, &[1.0], &p).is_err());
         assert!(detect_surface(&x, &[1.0, 0.0], &p).is_err());
-        let bad = SurfaceDetection {
-            min_empty_sector: 7.0,
-            ..p
-        };
+        let bad = SurfaceDetection { min_empty_sector: 7.0, ..p };
         assert!(detect_surface(&x, &[1.0, 1.0], &bad).is_err());
         assert_eq!(detect_surface(&x, &[1.0, 1.0], &p).unwrap(), vec![0, 1]);
     }

@@ -14,9 +14,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::force::{
-    coulomb_cap, inverse_distance_weights, one_step_normal_force, stick_force, Spreading,
-};
+use super::force::{coulomb_cap, inverse_distance_weights, one_step_normal_force, stick_force, Spreading};
 use super::rigid::RigidBody;
 use super::search::{check_pairing, search_rigid_polygon, Projection};
 use super::slave::{Pairing, SlaveSet};
@@ -71,30 +69,18 @@ impl ContactParameters {
     fn validate(&self) -> Result<(), ContactError> {
         let mu = self.friction_coefficient;
         if !(mu.is_finite() && mu >= 0.0) {
-            return Err(ContactError::InvalidParameter {
-                name: "friction_coefficient",
-                value: mu,
-            });
+            return Err(ContactError::InvalidParameter { name: "friction_coefficient", value: mu });
         }
         let r = self.inverse_distance_floor;
         if !(r.is_finite() && r > 0.0) {
-            return Err(ContactError::InvalidParameter {
-                name: "inverse_distance_floor",
-                value: r,
-            });
+            return Err(ContactError::InvalidParameter { name: "inverse_distance_floor", value: r });
         }
         if self.max_iterations == 0 {
-            return Err(ContactError::InvalidParameter {
-                name: "max_iterations",
-                value: 0.0,
-            });
+            return Err(ContactError::InvalidParameter { name: "max_iterations", value: 0.0 });
         }
         let t = self.tolerance;
         if !(t.is_finite() && t > 0.0) {
-            return Err(ContactError::InvalidParameter {
-                name: "tolerance",
-                value: t,
-            });
+            return Err(ContactError::InvalidParameter { name: "tolerance", value: t });
         }
         Ok(())
     }
@@ -162,29 +148,16 @@ impl<'a> StepInput<'a> {
         ];
         for (field, found) in lens {
             if found != n {
-                return Err(ContactError::LengthMismatch {
-                    field,
-                    expected: n,
-                    found,
-                });
+                return Err(ContactError::LengthMismatch { field, expected: n, found });
             }
         }
         if !(self.dt.is_finite() && self.dt > 0.0) {
-            return Err(ContactError::InvalidParameter {
-                name: "dt",
-                value: self.dt,
-            });
+            return Err(ContactError::InvalidParameter { name: "dt", value: self.dt });
         }
         if spreading != Spreading::None {
-            let table = self
-                .shape
-                .ok_or(ContactError::MissingShapeTable { spreading })?;
+            let table = self.shape.ok_or(ContactError::MissingShapeTable { spreading })?;
             if table.rows() != n {
-                return Err(ContactError::LengthMismatch {
-                    field: "shape rows",
-                    expected: n,
-                    found: table.rows(),
-                });
+                return Err(ContactError::LengthMismatch { field: "shape rows", expected: n, found: table.rows() });
             }
             let entries = table.index.len();
             let consistent = table.value.len() == entries
@@ -204,11 +177,7 @@ impl<'a> StepInput<'a> {
     fn predicted(&self, j: usize) -> Result<(Vec2, Vec2), ContactError> {
         let m = self.mass[j];
         if !(m.is_finite() && m > 0.0) {
-            return Err(ContactError::InvalidParticle {
-                particle: j,
-                field: "mass",
-                value: m,
-            });
+            return Err(ContactError::InvalidParticle { particle: j, field: "mass", value: m });
         }
         let flags = self.flags[j];
         let mut v = self.v[j] + (self.force_external[j] - self.force_internal[j]) * (self.dt / m);
@@ -321,11 +290,7 @@ pub struct ContactSystem {
 
 impl ContactSystem {
     /// A contact system; parameters are validated.
-    pub fn new(
-        bodies: Vec<RigidBody>,
-        slaves: SlaveSet,
-        params: ContactParameters,
-    ) -> Result<Self, ContactError> {
+    pub fn new(bodies: Vec<RigidBody>, slaves: SlaveSet, params: ContactParameters) -> Result<Self, ContactError> {
         params.validate()?;
         let nb = bodies.len();
         Ok(Self {
@@ -359,10 +324,7 @@ impl ContactSystem {
     /// Total cumulative contact work over all bodies, J (see
     /// [`BodySample::work_on_particles`] and [`BodySample::work_on_body`]).
     pub fn contact_work(&self) -> Real {
-        self.work_on_particles
-            .iter()
-            .chain(&self.work_on_body)
-            .sum()
+        self.work_on_particles.iter().chain(&self.work_on_body).sum()
     }
 
     /// Total linear momentum of the rigid bodies, kg m/s.
@@ -408,11 +370,7 @@ impl ContactSystem {
         ];
         for (field, found) in lens {
             if found != nb {
-                return Err(ContactError::LengthMismatch {
-                    field,
-                    expected: nb,
-                    found,
-                });
+                return Err(ContactError::LengthMismatch { field, expected: nb, found });
             }
         }
         self.work_on_particles = a.work_on_particles;
@@ -470,22 +428,14 @@ impl ContactSystem {
     /// 1.6e-3 h in case A, 5e-8 h with the solve. Tests:
     /// `compare_spreading_on_elastic_impact`,
     /// `shape_function_contact_of_an_isolated_point_is_exact`.
-    pub fn compute_forces(
-        &mut self,
-        input: &StepInput,
-        f_contact: &mut [Vec2],
-    ) -> Result<StepReport, ContactError> {
+    pub fn compute_forces(&mut self, input: &StepInput, f_contact: &mut [Vec2]) -> Result<StepReport, ContactError> {
         self.pending = None;
         self.params.validate()?;
         let spreading = self.params.spreading;
         input.validate(spreading)?;
         let n = input.x0.len();
         if f_contact.len() != n {
-            return Err(ContactError::LengthMismatch {
-                field: "f_contact",
-                expected: n,
-                found: f_contact.len(),
-            });
+            return Err(ContactError::LengthMismatch { field: "f_contact", expected: n, found: f_contact.len() });
         }
         self.slaves.check_indices(n)?;
         self.resize_per_body();
@@ -520,10 +470,7 @@ impl ContactSystem {
                 vel += v_pred * w;
             }
             if !x.iter().chain(vel.iter()).all(|c| c.is_finite()) {
-                return Err(ContactError::NonFinite {
-                    particle: s,
-                    quantity: "predicted position or velocity",
-                });
+                return Err(ContactError::NonFinite { particle: s, quantity: "predicted position or velocity" });
             }
             let last = self.slaves.pairing(k);
             let mut found: Option<Pairing> = None;
@@ -539,18 +486,10 @@ impl ContactSystem {
                 };
                 let from = x_now - body.position + at;
                 let fresh = || search_rigid_polygon(body, &at, &x, &from);
-                let Some(Projection {
-                    feature,
-                    gap,
-                    normal,
-                }) = reuse.or_else(fresh)
-                else {
+                let Some(Projection { feature, gap, normal }) = reuse.or_else(fresh) else {
                     continue;
                 };
-                let pairing = Pairing {
-                    body: b as u32,
-                    feature,
-                };
+                let pairing = Pairing { body: b as u32, feature };
                 found = Some(pairing);
                 if gap >= 0.0 {
                     continue;
@@ -559,12 +498,7 @@ impl ContactSystem {
                     Spreading::None | Spreading::ShapeFunction => gap_rows,
                     Spreading::InverseDistance => {
                         let start = self.force_w.len();
-                        inverse_distance_neighbours(
-                            input,
-                            s,
-                            self.params.inverse_distance_floor,
-                            &mut self.force_w,
-                        )?;
+                        inverse_distance_neighbours(input, s, self.params.inverse_distance_floor, &mut self.force_w)?;
                         (start as u32, self.force_w.len() as u32)
                     }
                 };
@@ -581,11 +515,8 @@ impl ContactSystem {
                     for &(jf, wf) in force_w {
                         if jf == j {
                             let r = mobility(input, j as usize);
-                            c_n +=
-                                wg * wf * (normal.x * normal.x * r.x + normal.y * normal.y * r.y);
-                            c_t += wg
-                                * wf
-                                * (tangent.x * tangent.x * r.x + tangent.y * tangent.y * r.y);
+                            c_n += wg * wf * (normal.x * normal.x * r.x + normal.y * normal.y * r.y);
+                            c_t += wg * wf * (tangent.x * tangent.x * r.x + tangent.y * tangent.y * r.y);
                         }
                     }
                 }
@@ -617,11 +548,7 @@ impl ContactSystem {
         let mu = self.params.friction_coefficient;
         let id = spreading == Spreading::InverseDistance;
         let mut iterations = 0;
-        let sweeps = if self.candidates.is_empty() {
-            0
-        } else {
-            self.params.max_iterations
-        };
+        let sweeps = if self.candidates.is_empty() { 0 } else { self.params.max_iterations };
         for _ in 0..sweeps {
             iterations += 1;
             let (mut change, mut scale): (Real, Real) = (0.0, 0.0);
@@ -634,15 +561,10 @@ impl ContactSystem {
                 let gap = c.gap + dt * dt * c.normal.dot(&du);
                 let f_n = (c.f_n + one_step_normal_force(c.mass_normal, gap, dt)).max(0.0);
                 let v_t = c.slip_velocity + dt * c.tangent.dot(&du);
-                let (f_t, slipping) =
-                    coulomb_cap(c.f_t + stick_force(c.mass_tangent, v_t, dt), mu * f_n);
+                let (f_t, slipping) = coulomb_cap(c.f_t + stick_force(c.mass_tangent, v_t, dt), mu * f_n);
                 let delta = c.normal * (f_n - c.f_n) + c.tangent * (f_t - c.f_t);
                 if delta != Vec2::zeros() {
-                    let rows = if id {
-                        &self.force_w[..]
-                    } else {
-                        &self.gap_w[..]
-                    };
+                    let rows = if id { &self.force_w[..] } else { &self.gap_w[..] };
                     for &(j, w) in &rows[c.force_rows.0 as usize..c.force_rows.1 as usize] {
                         f_contact[j as usize] += delta * w;
                     }
@@ -653,10 +575,7 @@ impl ContactSystem {
             }
             if !(change.is_finite() && scale.is_finite()) {
                 let particle = self.candidates.first().map_or(0, |c| c.particle as usize);
-                return Err(ContactError::NonFinite {
-                    particle,
-                    quantity: "contact force",
-                });
+                return Err(ContactError::NonFinite { particle, quantity: "contact force" });
             }
             if change <= self.params.tolerance * scale {
                 break;
@@ -672,18 +591,13 @@ impl ContactSystem {
                 continue; // released by its neighbours
             }
             let force = c.normal * c.f_n + c.tangent * c.f_t;
-            let rows = if id {
-                &self.force_w[..]
-            } else {
-                &self.gap_w[..]
-            };
+            let rows = if id { &self.force_w[..] } else { &self.gap_w[..] };
             let mut applied = Vec2::zeros();
             for &(j, w) in &rows[c.force_rows.0 as usize..c.force_rows.1 as usize] {
                 let f = force * w;
                 f_contact[j as usize] += f;
                 applied += f;
-                self.applied
-                    .push((j, c.pairing.body, f, input.v[j as usize]));
+                self.applied.push((j, c.pairing.body, f, input.v[j as usize]));
             }
             let b = c.pairing.body as usize;
             self.reaction[b] -= applied;
@@ -702,11 +616,7 @@ impl ContactSystem {
             });
         }
         self.pending = Some((dt, n));
-        Ok(StepReport {
-            active_contacts: self.contacts.len(),
-            force_on_particles: total,
-            iterations,
-        })
+        Ok(StepReport { active_contacts: self.contacts.len(), force_on_particles: total, iterations })
     }
 
     /// Finish the step (module doc, stage 3): `v` holds the particles' new
@@ -728,11 +638,7 @@ impl ContactSystem {
     pub fn advance(&mut self, v: &[Vec2]) -> Result<(), ContactError> {
         let (dt, n) = self.pending.ok_or(ContactError::AdvanceWithoutForces)?;
         if v.len() != n {
-            return Err(ContactError::LengthMismatch {
-                field: "v",
-                expected: n,
-                found: v.len(),
-            });
+            return Err(ContactError::LengthMismatch { field: "v", expected: n, found: v.len() });
         }
         self.pending = None;
         self.resize_per_body(); // bodies added since compute_forces feel no force
@@ -798,20 +704,14 @@ fn effective_mass(compliance: Real) -> Real {
 fn shape_row(input: &StepInput, s: usize, out: &mut Vec<(u32, Real)>) -> Result<(), ContactError> {
     // `validate` guarantees the table exists with one row per particle.
     let Some(table) = input.shape else {
-        return Err(ContactError::MissingShapeTable {
-            spreading: Spreading::ShapeFunction,
-        });
+        return Err(ContactError::MissingShapeTable { spreading: Spreading::ShapeFunction });
     };
     let n = input.x0.len();
     let mut sum = 0.0;
     for e in table.range(s) {
         let j = table.index[e];
         if j as usize >= n {
-            return Err(ContactError::ShapeIndexOutOfRange {
-                row: s,
-                particle: j as usize,
-                particles: n,
-            });
+            return Err(ContactError::ShapeIndexOutOfRange { row: s, particle: j as usize, particles: n });
         }
         sum += table.value[e];
         out.push((j, table.value[e]));
@@ -831,19 +731,13 @@ fn inverse_distance_neighbours(
     out: &mut Vec<(u32, Real)>,
 ) -> Result<(), ContactError> {
     let Some(table) = input.shape else {
-        return Err(ContactError::MissingShapeTable {
-            spreading: Spreading::InverseDistance,
-        });
+        return Err(ContactError::MissingShapeTable { spreading: Spreading::InverseDistance });
     };
     let n = input.x0.len();
     let xs = input.x0[s];
     let a = input.support[s];
     if let Some(e) = table.range(s).find(|&e| table.index[e] as usize >= n) {
-        return Err(ContactError::ShapeIndexOutOfRange {
-            row: s,
-            particle: table.index[e] as usize,
-            particles: n,
-        });
+        return Err(ContactError::ShapeIndexOutOfRange { row: s, particle: table.index[e] as usize, particles: n });
     }
     let candidates = table.range(s).map(|e| table.index[e]).filter_map(|j| {
         let d = input.x0[j as usize] - xs;
@@ -856,11 +750,7 @@ fn inverse_distance_neighbours(
     for &(j, _) in out.iter() {
         let m = input.mass[j as usize];
         if !(m.is_finite() && m > 0.0) {
-            return Err(ContactError::InvalidParticle {
-                particle: j as usize,
-                field: "mass",
-                value: m,
-            });
+            return Err(ContactError::InvalidParticle { particle: j as usize, field: "mass", value: m });
         }
     }
     Ok(())

@@ -4,8 +4,7 @@
 //! [`crate::fracture`] for the choices and deviations.
 
 use super::geometry::{
-    left_bisector, left_normal, point_segment_distance, sector_angles, sector_contains,
-    widest_empty_sector,
+    left_bisector, left_normal, point_segment_distance, sector_angles, sector_contains, widest_empty_sector,
 };
 use super::rows::{rebuild_rows_with_fallback, Basis};
 use super::visibility::{CrackSegments, CrackVisibility};
@@ -120,11 +119,7 @@ impl Crack {
             .map(|k| {
                 let (a, b) = (self.vertices[k].x0, self.vertices[k + 1].x0);
                 let d = (b - a).normalize();
-                let b_ext = if k + 2 == n && self.growing() {
-                    0.0
-                } else {
-                    ext
-                };
+                let b_ext = if k + 2 == n && self.growing() { 0.0 } else { ext };
                 (a - d * ext, b + d * b_ext)
             })
             .collect()
@@ -227,11 +222,7 @@ impl CrackGrowth {
 
     /// The visibility of the current crack set for `model`'s particles.
     pub fn visibility<'a>(&'a self, model: &'a Model) -> CrackVisibility<'a> {
-        CrackVisibility {
-            segments: &self.segments,
-            x0: &model.particles.x0,
-            face_side: &model.particles.face_side,
-        }
+        CrackVisibility { segments: &self.segments, x0: &model.particles.x0, face_side: &model.particles.face_side }
     }
 
     /// Per-particle criterion value: the lumped projection of the
@@ -244,10 +235,7 @@ impl CrackGrowth {
         };
         let (mut acc, mut wsum) = (0.0, 0.0);
         for j in model.gather.range(i) {
-            let (k, q) = (
-                model.gather.entry[j] as usize,
-                model.gather.point[j] as usize,
-            );
+            let (k, q) = (model.gather.entry[j] as usize, model.gather.point[j] as usize);
             let w = model.qp_shape.value[k] * model.quad.weight[q];
             acc += w * col[q];
             wsum += w;
@@ -267,11 +255,7 @@ impl CrackGrowth {
             GeometryMode::PlaneStrain => 2,
             GeometryMode::Axisymmetric => 1,
         };
-        let mut t: Vec<Real> = self
-            .cracks
-            .iter()
-            .filter_map(|c| c.arrested.map(|a| a.0))
-            .collect();
+        let mut t: Vec<Real> = self.cracks.iter().filter_map(|c| c.arrested.map(|a| a.0)).collect();
         t.sort_by(|a, b| a.partial_cmp(b).expect("finite times"));
         t.get(needed - 1).copied()
     }
@@ -280,12 +264,7 @@ impl CrackGrowth {
     /// growing crack arrests or advances by at most one particle, then new
     /// cracks nucleate. Returns the new crack-face particles (for the
     /// contact slave set).
-    pub fn grow(
-        &mut self,
-        model: &mut Model,
-        time: Real,
-        step: u64,
-    ) -> Result<Vec<usize>, FractureError> {
+    pub fn grow(&mut self, model: &mut Model, time: Real, step: u64) -> Result<Vec<usize>, FractureError> {
         let Some(critical) = self.params.critical_value() else {
             return Ok(Vec::new());
         };
@@ -349,23 +328,14 @@ impl CrackGrowth {
         arrest: bool,
     ) -> Result<(usize, Vec<usize>), FractureError> {
         if path.len() < 2 {
-            return Err(FractureError::InvalidPath(
-                "needs at least two particles".into(),
-            ));
+            return Err(FractureError::InvalidPath("needs at least two particles".into()));
         }
         let n = model.particles.len();
         if let Some(&bad) = path.iter().find(|&&i| i >= n) {
-            return Err(FractureError::InvalidPath(format!(
-                "particle {bad} does not exist ({n} particles)"
-            )));
+            return Err(FractureError::InvalidPath(format!("particle {bad} does not exist ({n} particles)")));
         }
-        if path
-            .iter()
-            .any(|&i| model.particles.flags[i].has(ParticleFlags::CRACK_FACE))
-        {
-            return Err(FractureError::InvalidPath(
-                "a particle of the path is already on a crack face".into(),
-            ));
+        if path.iter().any(|&i| model.particles.flags[i].has(ParticleFlags::CRACK_FACE)) {
+            return Err(FractureError::InvalidPath("a particle of the path is already on a crack face".into()));
         }
         let c = self.cracks.len();
         let mut faces = self.start_crack(model, path[0], path[1], Real::NAN, 0.0, 0)?;
@@ -391,14 +361,11 @@ impl CrackGrowth {
         let p = &model.particles;
         let r = self.params.radius_factor * p.spacing[i];
         let mut out = Vec::new();
-        self.grid
-            .as_ref()
-            .expect("grid built")
-            .for_each_candidate(&p.x0[i], r, |j| {
-                if j != i && p.body[j] == p.body[i] && (p.x0[j] - p.x0[i]).norm() <= r {
-                    out.push(j);
-                }
-            });
+        self.grid.as_ref().expect("grid built").for_each_candidate(&p.x0[i], r, |j| {
+            if j != i && p.body[j] == p.body[i] && (p.x0[j] - p.x0[i]).norm() <= r {
+                out.push(j);
+            }
+        });
         out.sort_unstable();
         out
     }
@@ -407,11 +374,7 @@ impl CrackGrowth {
     /// the empty sector wider than `θ_c` in its circle), if it is on one.
     fn outward_normal(&self, model: &Model, i: usize) -> Option<Vec2> {
         let xi = model.particles.x0[i];
-        let dirs: Vec<Vec2> = self
-            .circle(model, i)
-            .iter()
-            .map(|&j| model.particles.x0[j] - xi)
-            .collect();
+        let dirs: Vec<Vec2> = self.circle(model, i).iter().map(|&j| model.particles.x0[j] - xi).collect();
         let (width, start) = widest_empty_sector(&dirs);
         (width > self.params.fan_angle.to_radians()).then(|| {
             let a = start + 0.5 * width;
@@ -425,18 +388,11 @@ impl CrackGrowth {
         let (a, b) = (p.x0[i], p.x0[j]);
         let reach = (b - a).norm() + p.spacing[i];
         let mut hit = false;
-        self.grid.as_ref().expect("grid built").for_each_candidate(
-            &a,
-            reach.min(self.grid_cell(model)),
-            |k| {
-                if k != i
-                    && k != j
-                    && point_segment_distance(&a, &b, &p.x0[k]) < PASS_OVER_FRACTION * p.spacing[k]
-                {
-                    hit = true;
-                }
-            },
-        );
+        self.grid.as_ref().expect("grid built").for_each_candidate(&a, reach.min(self.grid_cell(model)), |k| {
+            if k != i && k != j && point_segment_distance(&a, &b, &p.x0[k]) < PASS_OVER_FRACTION * p.spacing[k] {
+                hit = true;
+            }
+        });
         hit
     }
 
@@ -483,11 +439,10 @@ impl CrackGrowth {
             }
             let xi = model.particles.x0[i];
             let exclusion = self.params.nucleation_distance_factor * model.particles.spacing[i];
-            let near = self.cracks.iter().any(|c| {
-                c.vertices
-                    .windows(2)
-                    .any(|w| point_segment_distance(&w[0].x0, &w[1].x0, &xi) < exclusion)
-            });
+            let near = self
+                .cracks
+                .iter()
+                .any(|c| c.vertices.windows(2).any(|w| point_segment_distance(&w[0].x0, &w[1].x0, &xi) < exclusion));
             if near {
                 continue;
             }
@@ -495,19 +450,14 @@ impl CrackGrowth {
             let mut best: Option<(Real, usize)> = None;
             for j in self.circle(model, i) {
                 let f = model.particles.flags[j];
-                if f.has(ParticleFlags::CRACK_FACE)
-                    || f.has(ParticleFlags::SLAVE)
-                    || f.has(ParticleFlags::SURFACE)
-                {
+                if f.has(ParticleFlags::CRACK_FACE) || f.has(ParticleFlags::SLAVE) || f.has(ParticleFlags::SURFACE) {
                     continue;
                 }
                 let value = self.criterion_value(model, j);
                 if value < critical || best.is_some_and(|(bv, _)| bv >= value) {
                     continue;
                 }
-                if self.passes_over(model, i, j)
-                    || self.segments.blocked(&xi, &model.particles.x0[j])
-                {
+                if self.passes_over(model, i, j) || self.segments.blocked(&xi, &model.particles.x0[j]) {
                     continue;
                 }
                 let inward = self.outward_normal(model, i).map(|n| -n);
@@ -540,29 +490,13 @@ impl CrackGrowth {
         let id = self.cracks.len();
         self.cracks.push(Crack {
             id,
-            vertices: vec![
-                CrackVertex {
-                    x0: xi,
-                    faces: None,
-                },
-                CrackVertex {
-                    x0: xj,
-                    faces: None,
-                },
-            ],
+            vertices: vec![CrackVertex { x0: xi, faces: None }, CrackVertex { x0: xj, faces: None }],
             tip: Some(j),
             offset,
             nucleated: (time, step),
             arrested: None,
         });
-        let split = Split {
-            parent: i,
-            vertex: xi,
-            incoming: d,
-            outgoing: d,
-            reach: (xj - xi).norm(),
-            offset,
-        };
+        let split = Split { parent: i, vertex: xi, incoming: d, outgoing: d, reach: (xj - xi).norm(), offset };
         let (l, r) = self.split(model, id, split)?;
         self.cracks[id].vertices[0].faces = Some((l as u32, r as u32));
         self.events.push(CrackEvent {
@@ -592,10 +526,7 @@ impl CrackGrowth {
         let outgoing = (xj - xt).normalize();
         let n = self.cracks[c].vertices.len();
         let last_len = (xt - self.cracks[c].vertices[n - 2].x0).norm();
-        self.cracks[c].vertices.push(CrackVertex {
-            x0: xj,
-            faces: None,
-        });
+        self.cracks[c].vertices.push(CrackVertex { x0: xj, faces: None });
         self.cracks[c].tip = Some(j);
         let split = Split {
             parent: tip,
@@ -619,13 +550,7 @@ impl CrackGrowth {
     }
 
     /// Arrest: split the tip in halves, extend the path by δ, stop.
-    fn arrest(
-        &mut self,
-        model: &mut Model,
-        c: usize,
-        time: Real,
-        step: u64,
-    ) -> Result<Vec<usize>, FractureError> {
+    fn arrest(&mut self, model: &mut Model, c: usize, time: Real, step: u64) -> Result<Vec<usize>, FractureError> {
         let tip = self.cracks[c].tip.expect("growing");
         let value = self.criterion_value(model, tip);
         let xt = model.particles.x0[tip];
@@ -633,41 +558,19 @@ impl CrackGrowth {
         let n = self.cracks[c].vertices.len();
         let last_len = (xt - self.cracks[c].vertices[n - 2].x0).norm();
         let offset = self.cracks[c].offset;
-        self.cracks[c].vertices.push(CrackVertex {
-            x0: xt + d * offset,
-            faces: None,
-        });
+        self.cracks[c].vertices.push(CrackVertex { x0: xt + d * offset, faces: None });
         self.cracks[c].tip = None;
         self.cracks[c].arrested = Some((time, step));
-        let split = Split {
-            parent: tip,
-            vertex: xt,
-            incoming: d,
-            outgoing: d,
-            reach: last_len,
-            offset,
-        };
+        let split = Split { parent: tip, vertex: xt, incoming: d, outgoing: d, reach: last_len, offset };
         let (l, r) = self.split(model, c, split)?;
         self.cracks[c].vertices[n - 1].faces = Some((l as u32, r as u32));
-        self.events.push(CrackEvent {
-            time,
-            step,
-            crack: c,
-            kind: EventKind::Arrest,
-            particles: vec![l, r],
-            value,
-        });
+        self.events.push(CrackEvent { time, step, crack: c, kind: EventKind::Arrest, particles: vec![l, r], value });
         Ok(vec![l, r])
     }
 
     /// Split a particle at a crack vertex and rebuild what the change
     /// touches. The crack's path must already hold its new vertices.
-    fn split(
-        &mut self,
-        model: &mut Model,
-        crack: usize,
-        s: Split,
-    ) -> Result<(usize, usize), FractureError> {
+    fn split(&mut self, model: &mut Model, crack: usize, s: Split) -> Result<(usize, usize), FractureError> {
         let momentum = model.particles.momentum();
         let (phi_l, phi_r) = sector_angles(&s.incoming, &s.outgoing);
         let two_pi = 2.0 * std::f64::consts::PI;
@@ -701,8 +604,8 @@ impl CrackGrowth {
         // and the old and new particle positions, grown by the largest
         // support in `rebuild_local` (a sight line lies inside the window
         // of the particle it ends at).
-        let radius = self.params.radius_factor * model.particles.spacing[l] * 1.01
-            + 2.0 * EXTENSION_PER_OFFSET * s.offset;
+        let radius =
+            self.params.radius_factor * model.particles.spacing[l] * 1.01 + 2.0 * EXTENSION_PER_OFFSET * s.offset;
         let mut lo = old_x.inf(&s.vertex);
         let mut hi = old_x.sup(&s.vertex);
         for (a, bb) in self.cracks[crack].segments() {
@@ -713,12 +616,11 @@ impl CrackGrowth {
                 }
             }
         }
-        self.rebuild_local(model, lo, hi, momentum)
-            .map_err(|source| FractureError::Shape {
-                crack,
-                particle: l,
-                source,
-            })?;
+        self.rebuild_local(model, lo, hi, momentum).map_err(|source| FractureError::Shape {
+            crack,
+            particle: l,
+            source,
+        })?;
         Ok((l, r))
     }
 
@@ -745,9 +647,7 @@ impl CrackGrowth {
         let (lo, hi) = (lo - Vec2::repeat(grow), hi + Vec2::repeat(grow));
         let inside = |x: &Vec2| x.x >= lo.x && x.x <= hi.x && x.y >= lo.y && x.y <= hi.y;
         let n = model.particles.len();
-        let rows_q: Vec<usize> = (0..model.quad.len())
-            .filter(|&q| inside(&model.quad.x0[q]))
-            .collect();
+        let rows_q: Vec<usize> = (0..model.quad.len()).filter(|&q| inside(&model.quad.x0[q])).collect();
         let ps = &mut model.particle_shape;
         while ps.rows() < n {
             let end = *ps.offsets.last().expect("offsets start at 0");
@@ -761,37 +661,16 @@ impl CrackGrowth {
             }
         }
         let p = &model.particles;
-        let vis = CrackVisibility {
-            segments: &self.segments,
-            x0: &p.x0,
-            face_side: &p.face_side,
-        };
+        let vis = CrackVisibility { segments: &self.segments, x0: &p.x0, face_side: &p.face_side };
         let mut qp_shape = std::mem::take(&mut model.qp_shape);
         let mut particle_shape = std::mem::take(&mut model.particle_shape);
-        let r1 = rebuild_rows_with_fallback(
-            &mut qp_shape,
-            &rows_q,
-            &model.quad.x0,
-            &p.x0,
-            &p.support,
-            &p.volume,
-            &vis,
-        );
-        let r2 = rebuild_rows_with_fallback(
-            &mut particle_shape,
-            &rows_p,
-            &p.x0,
-            &p.x0,
-            &p.support,
-            &p.volume,
-            &vis,
-        );
+        let r1 = rebuild_rows_with_fallback(&mut qp_shape, &rows_q, &model.quad.x0, &p.x0, &p.support, &p.volume, &vis);
+        let r2 = rebuild_rows_with_fallback(&mut particle_shape, &rows_p, &p.x0, &p.x0, &p.support, &p.volume, &vis);
         model.qp_shape = qp_shape;
         model.particle_shape = particle_shape;
-        for (rows, reduced, map) in [
-            (&rows_q, r1?, &mut self.reduced_quadrature_rows),
-            (&rows_p, r2?, &mut self.reduced_particle_rows),
-        ] {
+        for (rows, reduced, map) in
+            [(&rows_q, r1?, &mut self.reduced_quadrature_rows), (&rows_p, r2?, &mut self.reduced_particle_rows)]
+        {
             for r in rows {
                 map.remove(r);
             }
@@ -820,11 +699,7 @@ impl CrackGrowth {
             // in proportion to their masses: the total stays exact.
             let p = &mut model.particles;
             let after: Real = touched.iter().map(|&i| p.mass[i]).sum();
-            let rest: Real = touched
-                .iter()
-                .filter(|i| !floored.contains(i))
-                .map(|&i| p.mass[i])
-                .sum();
+            let rest: Real = touched.iter().filter(|i| !floored.contains(i)).map(|&i| p.mass[i]).sum();
             let scale = 1.0 - (after - before) / rest;
             for &i in touched.iter().filter(|i| !floored.contains(i)) {
                 p.mass[i] *= scale;
@@ -834,16 +709,8 @@ impl CrackGrowth {
         let p = &mut model.particles;
         let dp = momentum - p.momentum();
         for c in 0..2 {
-            let fix = if c == 0 {
-                ParticleFlags::FIX_X
-            } else {
-                ParticleFlags::FIX_Y
-            };
-            let free: Vec<usize> = touched
-                .iter()
-                .cloned()
-                .filter(|&i| !p.flags[i].has(fix))
-                .collect();
+            let fix = if c == 0 { ParticleFlags::FIX_X } else { ParticleFlags::FIX_Y };
+            let free: Vec<usize> = touched.iter().cloned().filter(|&i| !p.flags[i].has(fix)).collect();
             let m: Real = free.iter().map(|&i| p.mass[i]).sum();
             if m > 0.0 {
                 let shift = dp[c] / m;

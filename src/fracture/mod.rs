@@ -179,47 +179,22 @@ impl FractureParameters {
         let mut p = Vec::new();
         let pos = |v: Real| v.is_finite() && v > 0.0;
         if !pos(self.critical_effective_strain) {
-            p.push((
-                "critical_effective_strain",
-                format!("must be > 0, got {}", self.critical_effective_strain),
-            ));
+            p.push(("critical_effective_strain", format!("must be > 0, got {}", self.critical_effective_strain)));
         }
         if !pos(self.critical_damage) {
-            p.push((
-                "critical_damage",
-                format!("must be > 0, got {}", self.critical_damage),
-            ));
+            p.push(("critical_damage", format!("must be > 0, got {}", self.critical_damage)));
         }
         if !(self.radius_factor >= 1.0 && self.radius_factor <= 5.0) {
-            p.push((
-                "radius_factor",
-                format!(
-                    "must lie in [1, 5] (local spacings), got {}",
-                    self.radius_factor
-                ),
-            ));
+            p.push(("radius_factor", format!("must lie in [1, 5] (local spacings), got {}", self.radius_factor)));
         }
         if !(self.fan_angle > 0.0 && self.fan_angle < 180.0) {
-            p.push((
-                "fan_angle",
-                format!("must lie in (0, 180) degrees, got {}", self.fan_angle),
-            ));
+            p.push(("fan_angle", format!("must lie in (0, 180) degrees, got {}", self.fan_angle)));
         }
         if !(self.offset_ratio > 0.0 && self.offset_ratio <= 0.05) {
-            p.push((
-                "offset_ratio",
-                format!(
-                    "must lie in (0, 0.05] (|delta| << spacing), got {}",
-                    self.offset_ratio
-                ),
-            ));
+            p.push(("offset_ratio", format!("must lie in (0, 0.05] (|delta| << spacing), got {}", self.offset_ratio)));
         }
-        if !(self.nucleation_distance_factor.is_finite() && self.nucleation_distance_factor >= 0.0)
-        {
-            p.push((
-                "nucleation_distance_factor",
-                format!("must be >= 0, got {}", self.nucleation_distance_factor),
-            ));
+        if !(self.nucleation_distance_factor.is_finite() && self.nucleation_distance_factor >= 0.0) {
+            p.push(("nucleation_distance_factor", format!("must be >= 0, got {}", self.nucleation_distance_factor)));
         }
         p
     }

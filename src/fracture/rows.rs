@@ -60,14 +60,7 @@ impl Basis {
 /// One row `(particle, N, ∇N)` at `x` from the visible covering particles
 /// `cand`, with `basis`; `None` if the moment matrix is singular.
 #[allow(non_snake_case)]
-fn row_with_basis(
-    x: &Vec2,
-    cand: &[u32],
-    x0: &[Vec2],
-    support: &[Real],
-    volume: &[Real],
-    basis: Basis,
-) -> Option<Row> {
+fn row_with_basis(x: &Vec2, cand: &[u32], x0: &[Vec2], support: &[Real], volume: &[Real], basis: Basis) -> Option<Row> {
     // Legend: Z = X - X_I; p = scaled basis; phi = window x volume; M = moment matrix.
     let m = basis.size();
     if cand.len() < m {
@@ -140,13 +133,7 @@ pub fn row_with_fallback(
             return Ok((row, basis));
         }
     }
-    Err(ShapeError::SingularMoment {
-        point,
-        x: x.x,
-        y: x.y,
-        neighbours: cand.len(),
-        condition: Real::INFINITY,
-    })
+    Err(ShapeError::SingularMoment { point, x: x.x, y: x.y, neighbours: cand.len(), condition: Real::INFINITY })
 }
 
 /// Recompute rows `which` (ascending, unique) of `table` at `points`,
@@ -166,17 +153,13 @@ pub fn rebuild_rows_with_fallback(
     let mut fresh = Vec::with_capacity(which.len());
     let mut reduced = Vec::new();
     for &r in which {
-        let (row, basis) =
-            row_with_fallback(r, &points[r], &search, x0, support, volume, vis, &mut cand)?;
+        let (row, basis) = row_with_fallback(r, &points[r], &search, x0, support, volume, vis, &mut cand)?;
         if basis != Basis::Bilinear {
             reduced.push((r, basis));
         }
         fresh.push(row);
     }
-    let mut out = ShapeTable {
-        offsets: Vec::with_capacity(table.offsets.len()),
-        ..Default::default()
-    };
+    let mut out = ShapeTable { offsets: Vec::with_capacity(table.offsets.len()), ..Default::default() };
     out.offsets.push(0);
     let mut next = which.iter().zip(fresh).peekable();
     for r in 0..table.rows() {
@@ -208,9 +191,7 @@ mod tests {
     use crate::shape::{build_table, AllVisible};
 
     fn lattice(n: usize, h: Real) -> (Vec<Vec2>, Vec<Real>, Vec<Real>) {
-        let x0: Vec<Vec2> = (0..n * n)
-            .map(|k| Vec2::new((k % n) as Real * h, (k / n) as Real * h))
-            .collect();
+        let x0: Vec<Vec2> = (0..n * n).map(|k| Vec2::new((k % n) as Real * h, (k / n) as Real * h)).collect();
         (x0, vec![2.0 * h; n * n], vec![h * h; n * n])
     }
 
@@ -223,8 +204,7 @@ mod tests {
         let pts = vec![Vec2::new(3.3 * h, 2.7 * h), Vec2::new(0.1 * h, 0.2 * h)];
         let reference = build_table(&pts, &x0, &a, &v, &AllVisible).unwrap();
         let mut t = reference.clone();
-        let reduced =
-            rebuild_rows_with_fallback(&mut t, &[0, 1], &pts, &x0, &a, &v, &AllVisible).unwrap();
+        let reduced = rebuild_rows_with_fallback(&mut t, &[0, 1], &pts, &x0, &a, &v, &AllVisible).unwrap();
         assert!(reduced.is_empty());
         for k in 0..t.nnz() {
             assert_eq!(t.index[k], reference.index[k]);

@@ -48,11 +48,7 @@ impl std::fmt::Debug for CrackSegments {
 impl CrackSegments {
     /// Bin `segments` in cells of size `cell` (> 0, m).
     pub fn new(segments: Vec<(Vec2, Vec2)>, cell: Real) -> Self {
-        let cell = if cell > 0.0 && cell.is_finite() {
-            cell
-        } else {
-            1.0
-        };
+        let cell = if cell > 0.0 && cell.is_finite() { cell } else { 1.0 };
         let mut bins: HashMap<(i64, i64), Vec<u32>> = HashMap::new();
         for (k, (a, b)) in segments.iter().enumerate() {
             let (lo, hi) = (a.inf(b), a.sup(b));
@@ -64,11 +60,7 @@ impl CrackSegments {
                 }
             }
         }
-        CrackSegments {
-            segments,
-            cell,
-            bins,
-        }
+        CrackSegments { segments, cell, bins }
     }
 
     #[inline]

@@ -46,17 +46,10 @@ impl HistoryWriter {
                 None
             };
             if let Some(reason) = reason {
-                return Err(IoError::InvalidName {
-                    path: path.to_path_buf(),
-                    name: name.to_string(),
-                    reason,
-                });
+                return Err(IoError::InvalidName { path: path.to_path_buf(), name: name.to_string(), reason });
             }
         }
-        let write_error = |source| IoError::Write {
-            path: path.to_path_buf(),
-            source,
-        };
+        let write_error = |source| IoError::Write { path: path.to_path_buf(), source };
         let mut file = File::create(path).map_err(write_error)?;
         let header = format!("{}\n", columns.join(","));
         file.write_all(header.as_bytes()).map_err(write_error)?;
@@ -74,29 +67,14 @@ impl HistoryWriter {
     /// up to the checkpoint; later rows are dropped) and appends from there.
     /// `keep` must end at a line break and leave the header.
     pub fn continue_at(path: &Path, columns: &[&str], keep: u64) -> Result<Self, IoError> {
-        let read_error = |source| IoError::Read {
-            path: path.to_path_buf(),
-            source,
-        };
-        let parse_error = |message: String| IoError::Parse {
-            path: path.to_path_buf(),
-            line: 1,
-            message,
-        };
-        let mut file = std::fs::OpenOptions::new()
-            .read(true)
-            .write(true)
-            .open(path)
-            .map_err(read_error)?;
+        let read_error = |source| IoError::Read { path: path.to_path_buf(), source };
+        let parse_error = |message: String| IoError::Parse { path: path.to_path_buf(), line: 1, message };
+        let mut file = std::fs::OpenOptions::new().read(true).write(true).open(path).map_err(read_error)?;
         let header = format!("{}\n", columns.join(","));
         let mut head = vec![0u8; header.len()];
-        std::io::Read::read_exact(&mut file, &mut head)
-            .map_err(|_| parse_error("shorter than its header".into()))?;
+        std::io::Read::read_exact(&mut file, &mut head).map_err(|_| parse_error("shorter than its header".into()))?;
         if head != header.as_bytes() {
-            return Err(parse_error(format!(
-                "header differs from the run's columns `{}`",
-                columns.join(",")
-            )));
+            return Err(parse_error(format!("header differs from the run's columns `{}`", columns.join(","))));
         }
         let len = file.metadata().map_err(read_error)?.len();
         if keep < header.len() as u64 || keep > len {
@@ -108,14 +86,9 @@ impl HistoryWriter {
         std::io::Seek::seek(&mut file, std::io::SeekFrom::Start(keep - 1)).map_err(read_error)?;
         std::io::Read::read_exact(&mut file, &mut last).map_err(read_error)?;
         if last[0] != b'\n' {
-            return Err(parse_error(format!(
-                "byte {keep} is not the end of a row (the file was changed)"
-            )));
+            return Err(parse_error(format!("byte {keep} is not the end of a row (the file was changed)")));
         }
-        let write_error = |source| IoError::Write {
-            path: path.to_path_buf(),
-            source,
-        };
+        let write_error = |source| IoError::Write { path: path.to_path_buf(), source };
         file.set_len(keep).map_err(write_error)?;
         std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0)).map_err(write_error)?;
         Ok(Self {
@@ -135,10 +108,7 @@ impl HistoryWriter {
     /// Hands the rows written so far to the disk (`fsync`), so that they
     /// survive a power loss, not only a crash of the process.
     pub fn sync(&self) -> Result<(), IoError> {
-        self.file.sync_data().map_err(|source| IoError::Write {
-            path: self.path.clone(),
-            source,
-        })
+        self.file.sync_data().map_err(|source| IoError::Write { path: self.path.clone(), source })
     }
 
     /// Appends one row; `values` are in column order, one per column.
@@ -164,10 +134,7 @@ impl HistoryWriter {
         self.line.push('\n');
         self.file
             .write_all(self.line.as_bytes())
-            .map_err(|source| IoError::Write {
-                path: self.path.clone(),
-                source,
-            })?;
+            .map_err(|source| IoError::Write { path: self.path.clone(), source })?;
         self.bytes += self.line.len() as u64;
         Ok(())
     }
@@ -198,20 +165,10 @@ impl HistoryTable {
     /// line must have as many fields as the header, each parsing as `f64`
     /// (`NaN`, `inf` included). Errors name the file and the 1-based line.
     pub fn read(path: &Path) -> Result<Self, IoError> {
-        let text = std::fs::read_to_string(path).map_err(|source| IoError::Read {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        let parse_error = |line: usize, message: String| IoError::Parse {
-            path: path.to_path_buf(),
-            line,
-            message,
-        };
-        let mut lines = text
-            .lines()
-            .enumerate()
-            .map(|(i, l)| (i + 1, l.trim()))
-            .filter(|(_, l)| !l.is_empty());
+        let text =
+            std::fs::read_to_string(path).map_err(|source| IoError::Read { path: path.to_path_buf(), source })?;
+        let parse_error = |line: usize, message: String| IoError::Parse { path: path.to_path_buf(), line, message };
+        let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l.trim())).filter(|(_, l)| !l.is_empty());
         let Some((_, header)) = lines.next() else {
             return Err(parse_error(1, "no header line".into()));
         };
@@ -220,18 +177,13 @@ impl HistoryTable {
         for (number, line) in lines {
             let fields: Vec<&str> = line.split(',').collect();
             if fields.len() != columns.len() {
-                return Err(parse_error(
-                    number,
-                    format!("{} fields, expected {}", fields.len(), columns.len()),
-                ));
+                return Err(parse_error(number, format!("{} fields, expected {}", fields.len(), columns.len())));
             }
             for ((field, column), name) in fields.iter().zip(&mut values).zip(&columns) {
-                let value = field.trim().parse::<f64>().map_err(|_| {
-                    parse_error(
-                        number,
-                        format!("column `{name}`: `{field}` is not a number"),
-                    )
-                })?;
+                let value = field
+                    .trim()
+                    .parse::<f64>()
+                    .map_err(|_| parse_error(number, format!("column `{name}`: `{field}` is not a number")))?;
                 column.push(value);
             }
         }
@@ -271,17 +223,9 @@ mod tests {
         let rows: Vec<[f64; 4]> = (0..50)
             .map(|i| {
                 let t = i as f64 * 2.5e-8;
-                [
-                    t,
-                    0.5 * 1e3 * (i as f64).sin().powi(2),
-                    -312.7 / (i + 1) as f64,
-                    i as f64,
-                ]
+                [t, 0.5 * 1e3 * (i as f64).sin().powi(2), -312.7 / (i + 1) as f64, i as f64]
             })
-            .chain([
-                [1e-300, f64::MAX, -0.0, 0.1 + 0.2],
-                [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 7.0],
-            ])
+            .chain([[1e-300, f64::MAX, -0.0, 0.1 + 0.2], [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 7.0]])
             .collect();
         for row in &rows {
             writer.write_row(row).unwrap();
@@ -330,30 +274,14 @@ mod tests {
         let dir = scratch_dir("csv-errors");
         let path = dir.join("h.csv");
         let mut writer = HistoryWriter::create(&path, &["a", "b"]).unwrap();
-        assert!(matches!(
-            writer.write_row(&[1.0]),
-            Err(IoError::RowLength {
-                expected: 2,
-                found: 1,
-                ..
-            })
-        ));
+        assert!(matches!(writer.write_row(&[1.0]), Err(IoError::RowLength { expected: 2, found: 1, .. })));
         for bad in [["a", "a"], ["a", ""], ["a,b", "c"], [" a", "b"]] {
-            assert!(
-                matches!(
-                    HistoryWriter::create(&path, &bad),
-                    Err(IoError::InvalidName { .. })
-                ),
-                "{bad:?}"
-            );
+            assert!(matches!(HistoryWriter::create(&path, &bad), Err(IoError::InvalidName { .. })), "{bad:?}");
         }
         let missing = unwritable_path("h.csv");
         let err = HistoryWriter::create(&missing, &["a"]).unwrap_err();
         assert!(matches!(&err, IoError::Write { path: p, .. } if *p == missing));
-        assert!(matches!(
-            HistoryTable::read(&missing),
-            Err(IoError::Read { .. })
-        ));
+        assert!(matches!(HistoryTable::read(&missing), Err(IoError::Read { .. })));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
@@ -362,20 +290,11 @@ mod tests {
         let dir = scratch_dir("csv-malformed");
         let path = dir.join("h.csv");
         std::fs::write(&path, "t, x\n0, 1\n\n1, 2, 3\n").unwrap();
-        assert!(matches!(
-            HistoryTable::read(&path),
-            Err(IoError::Parse { line: 4, .. })
-        ));
+        assert!(matches!(HistoryTable::read(&path), Err(IoError::Parse { line: 4, .. })));
         std::fs::write(&path, "t,x\n0,abc\n").unwrap();
-        assert!(matches!(
-            HistoryTable::read(&path),
-            Err(IoError::Parse { line: 2, .. })
-        ));
+        assert!(matches!(HistoryTable::read(&path), Err(IoError::Parse { line: 2, .. })));
         std::fs::write(&path, "").unwrap();
-        assert!(matches!(
-            HistoryTable::read(&path),
-            Err(IoError::Parse { .. })
-        ));
+        assert!(matches!(HistoryTable::read(&path), Err(IoError::Parse { .. })));
         std::fs::write(&path, " t , x \r\n 0.5 , -1e-3 \r\n").unwrap();
         let table = HistoryTable::read(&path).unwrap();
         assert_eq!(table.column("x").unwrap(), [-1e-3]);

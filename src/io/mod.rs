@@ -144,11 +144,7 @@ pub enum IoError {
 
 /// Value of the `byte_order` attribute matching the native byte order, in
 /// which all binary data are written (`bytemuck` casts, no byte swapping).
-pub(crate) const BYTE_ORDER: &str = if cfg!(target_endian = "big") {
-    "BigEndian"
-} else {
-    "LittleEndian"
-};
+pub(crate) const BYTE_ORDER: &str = if cfg!(target_endian = "big") { "BigEndian" } else { "LittleEndian" };
 
 /// Writes `path` as a whole: `write` fills a temporary file next to it,
 /// which is then renamed over `path`.
@@ -160,10 +156,7 @@ pub(crate) fn write_atomically(
     path: &Path,
     write: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
 ) -> Result<(), IoError> {
-    let fail = |source| IoError::Write {
-        path: path.to_path_buf(),
-        source,
-    };
+    let fail = |source| IoError::Write { path: path.to_path_buf(), source };
     let tmp = temporary_sibling(path, "").map_err(fail)?;
     let result = File::create(&tmp).and_then(|file| {
         let mut writer = BufWriter::new(file);
@@ -182,9 +175,9 @@ pub(crate) fn write_atomically(
 /// unique within this process, and ending in `suffix`.
 pub(crate) fn temporary_sibling(path: &Path, suffix: &str) -> std::io::Result<PathBuf> {
     static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let name = path.file_name().ok_or_else(|| {
-        std::io::Error::new(std::io::ErrorKind::InvalidInput, "path has no file name")
-    })?;
+    let name = path
+        .file_name()
+        .ok_or_else(|| std::io::Error::new(std::io::ErrorKind::InvalidInput, "path has no file name"))?;
     let unique = COUNTER.fetch_add(1, Ordering::Relaxed);
     let mut tmp_name = std::ffi::OsString::from(".");
     tmp_name.push(name);
@@ -234,10 +227,7 @@ pub(crate) mod test_util {
 
     /// A path whose parent directory does not exist, so writing fails.
     pub fn unwritable_path(file: &str) -> PathBuf {
-        std::env::temp_dir()
-            .join(format!("plugsim-io-missing-{}", std::process::id()))
-            .join("no-such-dir")
-            .join(file)
+        std::env::temp_dir().join(format!("plugsim-io-missing-{}", std::process::id())).join("no-such-dir").join(file)
     }
 
     /// Checks that `xml` is well formed at the level the writers use:
@@ -254,10 +244,7 @@ pub(crate) mod test_util {
             rest = &rest[end + 1..];
             if tag.starts_with('?') {
                 assert!(tag.ends_with('?'), "bad declaration <{tag}>");
-                assert!(
-                    stack.is_empty() && names.is_empty(),
-                    "declaration not first"
-                );
+                assert!(stack.is_empty() && names.is_empty(), "declaration not first");
                 continue;
             }
             if let Some(name) = tag.strip_prefix('/') {
@@ -266,17 +253,8 @@ pub(crate) mod test_util {
                 continue;
             }
             let self_closing = tag.ends_with('/');
-            let name: String = tag
-                .trim_end_matches('/')
-                .split_whitespace()
-                .next()
-                .expect("empty tag")
-                .to_string();
-            assert_eq!(
-                tag.matches('"').count() % 2,
-                0,
-                "unbalanced quotes in <{tag}>"
-            );
+            let name: String = tag.trim_end_matches('/').split_whitespace().next().expect("empty tag").to_string();
+            assert_eq!(tag.matches('"').count() % 2, 0, "unbalanced quotes in <{tag}>");
             if stack.is_empty() {
                 roots += 1;
             }
@@ -323,19 +301,12 @@ mod tests {
             0.1 + 0.2,
         ] {
             let text = format_real(v);
-            assert_eq!(
-                text.parse::<f64>().unwrap().to_bits(),
-                v.to_bits(),
-                "{text}"
-            );
+            assert_eq!(text.parse::<f64>().unwrap().to_bits(), v.to_bits(), "{text}");
         }
         assert_eq!(format_real(1.25e-5), "1.25e-5");
         assert_eq!(format_real(0.5), "0.5");
         assert!(format_real(f64::NAN).parse::<f64>().unwrap().is_nan());
-        assert_eq!(
-            format_real(f64::NEG_INFINITY).parse::<f64>().unwrap(),
-            f64::NEG_INFINITY
-        );
+        assert_eq!(format_real(f64::NEG_INFINITY).parse::<f64>().unwrap(), f64::NEG_INFINITY);
     }
 
     #[test]

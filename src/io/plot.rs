@@ -106,11 +106,7 @@ pub fn save_line_plot(path: &Path, plot: &LinePlot) -> Result<(), PlotError> {
 /// Ranges are automatic: the finite data (and reference lines) plus 5 %
 /// padding; a constant or single-point series gets a range of ±5 % of its
 /// value (±1 around zero).
-pub fn save_line_plot_sized(
-    path: &Path,
-    plot: &LinePlot,
-    size: (u32, u32),
-) -> Result<(), PlotError> {
+pub fn save_line_plot_sized(path: &Path, plot: &LinePlot, size: (u32, u32)) -> Result<(), PlotError> {
     render_png(path, size, MIN_SIZE, |root| draw_line_plot(root, plot))
 }
 
@@ -121,19 +117,11 @@ pub fn save_field_plot(path: &Path, plot: &FieldPlot) -> Result<(), PlotError> {
 
 /// Renders `plot` to a PNG file at `path`, `size` = (width, height) pixels,
 /// at least [`MIN_SIZE`]. `plot.values` must have one value per point.
-pub fn save_field_plot_sized(
-    path: &Path,
-    plot: &FieldPlot,
-    size: (u32, u32),
-) -> Result<(), PlotError> {
+pub fn save_field_plot_sized(path: &Path, plot: &FieldPlot, size: (u32, u32)) -> Result<(), PlotError> {
     if plot.points.len() != plot.values.len() {
         return Err(PlotError::InvalidInput {
             path: path.display().to_string(),
-            message: format!(
-                "{} points but {} values",
-                plot.points.len(),
-                plot.values.len()
-            ),
+            message: format!("{} points but {} values", plot.points.len(), plot.values.len()),
         });
     }
     render_png(path, size, MIN_SIZE, |root| draw_field_plot(root, plot))
@@ -149,9 +137,7 @@ static DEJAVU_SANS: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 /// every text element fails with `FontUnavailable`.
 fn register_embedded_font() -> bool {
     static REGISTERED: OnceLock<bool> = OnceLock::new();
-    *REGISTERED.get_or_init(|| {
-        plotters::style::register_font(FONT, FontStyle::Normal, DEJAVU_SANS).is_ok()
-    })
+    *REGISTERED.get_or_init(|| plotters::style::register_font(FONT, FontStyle::Normal, DEJAVU_SANS).is_ok())
 }
 
 type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
@@ -168,16 +154,10 @@ fn render_png(
     if size.0 < min_size.0 || size.1 < min_size.1 {
         return Err(PlotError::InvalidInput {
             path: display,
-            message: format!(
-                "size {}x{} is below the minimum {}x{}",
-                size.0, size.1, min_size.0, min_size.1
-            ),
+            message: format!("size {}x{} is below the minimum {}x{}", size.0, size.1, min_size.0, min_size.1),
         });
     }
-    let fail = |message: String| PlotError::Draw {
-        path: display.clone(),
-        message,
-    };
+    let fail = |message: String| PlotError::Draw { path: display.clone(), message };
     if !register_embedded_font() {
         return Err(fail("the embedded font could not be loaded".into()));
     }
@@ -217,29 +197,17 @@ const X_LABEL_AREA: u32 = 60;
 const Y_LABEL_AREA: u32 = 100;
 
 fn draw_line_plot(root: &Area, plot: &LinePlot) -> Result<(), String> {
-    let xs = plot
-        .series
-        .iter()
-        .flat_map(|s| s.points.iter().map(|p| p.0));
-    let ys = plot
-        .series
-        .iter()
-        .flat_map(|s| s.points.iter().map(|p| p.1))
-        .chain(plot.hlines.iter().map(|h| h.1));
+    let xs = plot.series.iter().flat_map(|s| s.points.iter().map(|p| p.0));
+    let ys = plot.series.iter().flat_map(|s| s.points.iter().map(|p| p.1)).chain(plot.hlines.iter().map(|h| h.1));
     let (x0, x1) = padded_range(finite_min_max(xs));
     let (y0, y1) = padded_range(finite_min_max(ys));
 
     let mut builder = ChartBuilder::on(root);
-    builder
-        .margin(MARGIN)
-        .x_label_area_size(X_LABEL_AREA)
-        .y_label_area_size(Y_LABEL_AREA);
+    builder.margin(MARGIN).x_label_area_size(X_LABEL_AREA).y_label_area_size(Y_LABEL_AREA);
     if !plot.title.is_empty() {
         builder.caption(&plot.title, (FONT, 28));
     }
-    let mut chart = builder
-        .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(|e| e.to_string())?;
+    let mut chart = builder.build_cartesian_2d(x0..x1, y0..y1).map_err(|e| e.to_string())?;
     let x_ticks = tick_formatter(x0, x1);
     let y_ticks = tick_formatter(y0, y1);
     let (x_count, y_count) = label_counts(chart.plotting_area().dim_in_pixel());
@@ -264,9 +232,8 @@ fn draw_line_plot(root: &Area, plot: &LinePlot) -> Result<(), String> {
             runs.push(Vec::new());
         }
         for (k, run) in runs.iter().enumerate() {
-            let annotation = chart
-                .draw_series(LineSeries::new(run.iter().copied(), style))
-                .map_err(|e| e.to_string())?;
+            let annotation =
+                chart.draw_series(LineSeries::new(run.iter().copied(), style)).map_err(|e| e.to_string())?;
             if k == 0 && !series.name.is_empty() {
                 annotation
                     .label(series.name.as_str())
@@ -280,25 +247,16 @@ fn draw_line_plot(root: &Area, plot: &LinePlot) -> Result<(), String> {
         }
     }
 
-    let label_style = TextStyle::from((FONT, 16).into_font())
-        .color(&REFERENCE_LINE)
-        .pos(Pos::new(HPos::Right, VPos::Bottom));
+    let label_style =
+        TextStyle::from((FONT, 16).into_font()).color(&REFERENCE_LINE).pos(Pos::new(HPos::Right, VPos::Bottom));
     for (label, y) in plot.hlines.iter().filter(|h| h.1.is_finite()) {
         let y = &y.clamp(-AXIS_LIMIT, AXIS_LIMIT);
         chart
-            .draw_series(DashedLineSeries::new(
-                [(x0, *y), (x1, *y)],
-                10,
-                6,
-                REFERENCE_LINE.stroke_width(2),
-            ))
+            .draw_series(DashedLineSeries::new([(x0, *y), (x1, *y)], 10, 6, REFERENCE_LINE.stroke_width(2)))
             .map_err(|e| e.to_string())?;
         if !label.is_empty() {
-            let text = EmptyElement::at((x1, *y))
-                + Text::new(label.clone(), (-6, -4), label_style.clone());
-            chart
-                .draw_series(std::iter::once(text))
-                .map_err(|e| e.to_string())?;
+            let text = EmptyElement::at((x1, *y)) + Text::new(label.clone(), (-6, -4), label_style.clone());
+            chart.draw_series(std::iter::once(text)).map_err(|e| e.to_string())?;
         }
     }
 
@@ -323,30 +281,18 @@ fn draw_field_plot(root: &Area, plot: &FieldPlot) -> Result<(), String> {
     let root = if plot.title.is_empty() {
         root.clone()
     } else {
-        root.margin(10, 0, 0, 0)
-            .titled(&plot.title, (FONT, 28))
-            .map_err(|e| e.to_string())?
+        root.margin(10, 0, 0, 0).titled(&plot.title, (FONT, 28)).map_err(|e| e.to_string())?
     };
     let (width, height) = root.dim_in_pixel();
     let (main, bar) = root.split_horizontally(width.saturating_sub(COLORBAR_STRIP));
 
     // Equal scale on both axes: pad the data box by 5 % of its larger side,
     // then widen the shorter direction to the plot area's aspect ratio.
-    let coords = plot
-        .points
-        .iter()
-        .chain(plot.lines.iter().flatten())
-        .filter(|p| p.0.is_finite() && p.1.is_finite());
+    let coords = plot.points.iter().chain(plot.lines.iter().flatten()).filter(|p| p.0.is_finite() && p.1.is_finite());
     let xs = finite_min_max(coords.clone().map(|p| p.0));
     let ys = finite_min_max(coords.map(|p| p.1));
     let plot_px = (
-        f64::from(
-            (main
-                .dim_in_pixel()
-                .0
-                .saturating_sub(2 * MARGIN + Y_LABEL_AREA))
-            .max(1),
-        ),
+        f64::from((main.dim_in_pixel().0.saturating_sub(2 * MARGIN + Y_LABEL_AREA)).max(1)),
         f64::from((height.saturating_sub(2 * MARGIN + X_LABEL_AREA)).max(1)),
     );
     let ((x0, x1), (y0, y1)) = equal_scale_ranges(xs, ys, plot_px);
@@ -388,14 +334,11 @@ fn draw_field_plot(root: &Area, plot: &FieldPlot) -> Result<(), String> {
     };
 
     // Non-finite values first (underneath), then ascending value.
-    let mut order: Vec<usize> = (0..plot.points.len())
-        .filter(|&i| plot.points[i].0.is_finite() && plot.points[i].1.is_finite())
-        .collect();
+    let mut order: Vec<usize> =
+        (0..plot.points.len()).filter(|&i| plot.points[i].0.is_finite() && plot.points[i].1.is_finite()).collect();
     order.sort_by(|&a, &b| {
         let (va, vb) = (plot.values[a], plot.values[b]);
-        (va.is_finite(), va)
-            .partial_cmp(&(vb.is_finite(), vb))
-            .unwrap_or(std::cmp::Ordering::Equal)
+        (va.is_finite(), va).partial_cmp(&(vb.is_finite(), vb)).unwrap_or(std::cmp::Ordering::Equal)
     });
     // Marker radius: half the mean point spacing in pixels, estimated from
     // the points' bounding box (its diagonal for points along a line),
@@ -403,32 +346,17 @@ fn draw_field_plot(root: &Area, plot: &FieldPlot) -> Result<(), String> {
     let bbox = finite_min_max(order.iter().map(|&i| plot.points[i].0))
         .zip(finite_min_max(order.iter().map(|&i| plot.points[i].1)));
     let radius = bbox.map_or(4.0, |((xa, xb), (ya, yb))| {
-        let (w, h) = (
-            (xb - xa) / (x1 - x0) * plot_px.0,
-            (yb - ya) / (y1 - y0) * plot_px.1,
-        );
+        let (w, h) = ((xb - xa) / (x1 - x0) * plot_px.0, (yb - ya) / (y1 - y0) * plot_px.1);
         let n = order.len() as f64;
-        let spacing = if w * h > 0.0 {
-            (w * h / n).sqrt()
-        } else {
-            w.hypot(h) / n
-        };
+        let spacing = if w * h > 0.0 { (w * h / n).sqrt() } else { w.hypot(h) / n };
         (0.5 * spacing).round().clamp(1.0, 8.0)
     }) as i32;
     chart
-        .draw_series(order.iter().map(|&i| {
-            Circle::new(
-                clip(plot.points[i]),
-                radius,
-                colour(plot.values[i]).filled(),
-            )
-        }))
+        .draw_series(order.iter().map(|&i| Circle::new(clip(plot.points[i]), radius, colour(plot.values[i]).filled())))
         .map_err(|e| e.to_string())?;
     for line in &plot.lines {
         for run in finite_runs(line) {
-            chart
-                .draw_series(LineSeries::new(run, BLACK.stroke_width(2)))
-                .map_err(|e| e.to_string())?;
+            chart.draw_series(LineSeries::new(run, BLACK.stroke_width(2))).map_err(|e| e.to_string())?;
         }
     }
 
@@ -459,10 +387,7 @@ fn draw_field_plot(root: &Area, plot: &FieldPlot) -> Result<(), String> {
         .draw_series((0..STEPS).map(|k| {
             let lo = v0 + (v1 - v0) * k as f64 / STEPS as f64;
             let hi = v0 + (v1 - v0) * (k + 1) as f64 / STEPS as f64;
-            Rectangle::new(
-                [(0.0, lo), (1.0, hi)],
-                viridis((k as f64 + 0.5) / STEPS as f64).filled(),
-            )
+            Rectangle::new([(0.0, lo), (1.0, hi)], viridis((k as f64 + 0.5) / STEPS as f64).filled())
         }))
         .map_err(|e| e.to_string())?;
     Ok(())
@@ -471,10 +396,7 @@ fn draw_field_plot(root: &Area, plot: &FieldPlot) -> Result<(), String> {
 /// Maximum numbers of tick labels on the x and y axes of a plot area of
 /// `pixels` (width, height), so that labels do not overlap.
 fn label_counts(pixels: (u32, u32)) -> (usize, usize) {
-    (
-        (pixels.0 / 90).clamp(2, 10) as usize,
-        (pixels.1 / 50).clamp(2, 10) as usize,
-    )
+    ((pixels.0 / 90).clamp(2, 10) as usize, (pixels.1 / 50).clamp(2, 10) as usize)
 }
 
 /// Largest magnitude an axis range reaches: plotters' tick generator loops
@@ -485,13 +407,10 @@ const AXIS_LIMIT: f64 = 1e300;
 /// Minimum and maximum of the finite values, clamped to ±[`AXIS_LIMIT`];
 /// `None` if there are no finite values.
 fn finite_min_max(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
-    values
-        .filter(|v| v.is_finite())
-        .map(|v| v.clamp(-AXIS_LIMIT, AXIS_LIMIT))
-        .fold(None, |acc, v| match acc {
-            None => Some((v, v)),
-            Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
-        })
+    values.filter(|v| v.is_finite()).map(|v| v.clamp(-AXIS_LIMIT, AXIS_LIMIT)).fold(None, |acc, v| match acc {
+        None => Some((v, v)),
+        Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
+    })
 }
 
 /// An axis range around `min_max` with 5 % padding. A degenerate range
@@ -521,18 +440,12 @@ fn padded_range(min_max: Option<(f64, f64)>) -> (f64, f64) {
 
 /// x and y ranges containing the boxes `xs` and `ys` with equal data units
 /// per pixel on both axes, for a plot area of `pixels` (width, height).
-fn equal_scale_ranges(
-    xs: Option<(f64, f64)>,
-    ys: Option<(f64, f64)>,
-    pixels: (f64, f64),
-) -> ((f64, f64), (f64, f64)) {
+fn equal_scale_ranges(xs: Option<(f64, f64)>, ys: Option<(f64, f64)>, pixels: (f64, f64)) -> ((f64, f64), (f64, f64)) {
     let (Some(xs), Some(ys)) = (xs, ys) else {
         return ((0.0, 1.0), (0.0, 1.0));
     };
     let span = (xs.1 - xs.0).max(ys.1 - ys.0);
-    let magnitude = [xs.0, xs.1, ys.0, ys.1]
-        .iter()
-        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let magnitude = [xs.0, xs.1, ys.0, ys.1].iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let pad = if span > 1e-12 * magnitude {
         0.05 * span
     } else if magnitude > 0.0 {
@@ -545,10 +458,7 @@ fn equal_scale_ranges(
     let scale = ((x1 - x0) / pixels.0).max((y1 - y0) / pixels.1);
     let (xc, yc) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
     let (hx, hy) = (0.5 * scale * pixels.0, 0.5 * scale * pixels.1);
-    if [xc - hx, xc + hx, yc - hy, yc + hy]
-        .iter()
-        .all(|v| v.is_finite())
-    {
+    if [xc - hx, xc + hx, yc - hy, yc + hy].iter().all(|v| v.is_finite()) {
         ((xc - hx, xc + hx), (yc - hy, yc + hy))
     } else {
         ((x0, x1), (y0, y1))
@@ -559,10 +469,7 @@ fn equal_scale_ranges(
 /// inside the automatic ranges (plotters' pixel mapping overflows on points
 /// far outside the range).
 fn clip(point: (f64, f64)) -> (f64, f64) {
-    (
-        point.0.clamp(-AXIS_LIMIT, AXIS_LIMIT),
-        point.1.clamp(-AXIS_LIMIT, AXIS_LIMIT),
-    )
+    (point.0.clamp(-AXIS_LIMIT, AXIS_LIMIT), point.1.clamp(-AXIS_LIMIT, AXIS_LIMIT))
 }
 
 /// Splits `points` into runs of consecutive finite points, [`clip`]ped.
@@ -656,9 +563,7 @@ mod tests {
             series: vec![
                 Series {
                     name: "RKPM".into(),
-                    points: (0..200)
-                        .map(|i| (i as f64 * 0.1, 300.0 * (-(i as f64) / 80.0).exp()))
-                        .collect(),
+                    points: (0..200).map(|i| (i as f64 * 0.1, 300.0 * (-(i as f64) / 80.0).exp())).collect(),
                 },
                 Series {
                     name: "experiment".into(),
@@ -701,13 +606,7 @@ mod tests {
             vec![],
         ];
         for (i, points) in cases.into_iter().enumerate() {
-            let plot = LinePlot {
-                series: vec![Series {
-                    name: format!("case {i}"),
-                    points,
-                }],
-                ..LinePlot::default()
-            };
+            let plot = LinePlot { series: vec![Series { name: format!("case {i}"), points }], ..LinePlot::default() };
             let path = dir.join(format!("case{i}.png"));
             save_line_plot(&path, &plot).unwrap();
             assert_eq!(png_size(&path), DEFAULT_SIZE);
@@ -727,15 +626,9 @@ mod tests {
         assert!(matches!(err, PlotError::Draw { .. }));
 
         let dir = scratch_dir("plot-invalid");
-        let mismatched = FieldPlot {
-            values: vec![1.0],
-            ..sample_field_plot()
-        };
+        let mismatched = FieldPlot { values: vec![1.0], ..sample_field_plot() };
         let out = dir.join("f.png");
-        assert!(matches!(
-            save_field_plot(&out, &mismatched),
-            Err(PlotError::InvalidInput { .. })
-        ));
+        assert!(matches!(save_field_plot(&out, &mismatched), Err(PlotError::InvalidInput { .. })));
         assert!(matches!(
             save_line_plot_sized(&out, &sample_line_plot(), (10, 10)),
             Err(PlotError::InvalidInput { .. })
@@ -779,17 +672,10 @@ mod tests {
             (vec![(0.0, 0.0)], vec![3.0]),
             (vec![(0.0, 0.0), (1.0, 0.0)], vec![2.0, 2.0]),
             (vec![(1.0, 1.0), (1.0, 1.0)], vec![f64::NAN, f64::INFINITY]),
-            (
-                vec![(-f64::MAX, 0.0), (f64::MAX, f64::MAX), (0.0, f64::NAN)],
-                vec![-f64::MAX, f64::MAX, 0.0],
-            ),
+            (vec![(-f64::MAX, 0.0), (f64::MAX, f64::MAX), (0.0, f64::NAN)], vec![-f64::MAX, f64::MAX, 0.0]),
         ];
         for (i, (points, values)) in degenerate.into_iter().enumerate() {
-            let plot = FieldPlot {
-                points,
-                values,
-                ..FieldPlot::default()
-            };
+            let plot = FieldPlot { points, values, ..FieldPlot::default() };
             let path = dir.join(format!("degenerate{i}.png"));
             save_field_plot_sized(&path, &plot, (500, 400)).unwrap();
             assert_eq!(png_size(&path), (500, 400));
@@ -799,8 +685,7 @@ mod tests {
 
     #[test]
     fn equal_scale_ranges_have_equal_units_per_pixel() {
-        let ((x0, x1), (y0, y1)) =
-            equal_scale_ranges(Some((0.0, 0.1)), Some((-0.01, 0.02)), (700.0, 500.0));
+        let ((x0, x1), (y0, y1)) = equal_scale_ranges(Some((0.0, 0.1)), Some((-0.01, 0.02)), (700.0, 500.0));
         assert!(x0 <= 0.0 && x1 >= 0.1 && y0 <= -0.01 && y1 >= 0.02);
         let (sx, sy) = ((x1 - x0) / 700.0, (y1 - y0) / 500.0);
         assert!((sx - sy).abs() <= 1e-12 * sx, "{sx} {sy}");

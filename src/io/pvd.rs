@@ -35,10 +35,7 @@ impl PvdSeries {
     /// Starts a new, empty series at `path` and writes it immediately
     /// (replacing any existing file), so a bad path fails before the run.
     pub fn create(path: &Path) -> Result<Self, IoError> {
-        let series = Self {
-            path: path.to_path_buf(),
-            entries: Vec::new(),
-        };
+        let series = Self { path: path.to_path_buf(), entries: Vec::new() };
         series.write()?;
         Ok(series)
     }
@@ -46,10 +43,7 @@ impl PvdSeries {
     /// A series that continues with `entries` already in it (a resumed
     /// run), written immediately (replacing any existing file).
     pub fn with_entries(path: &Path, entries: Vec<PvdEntry>) -> Result<Self, IoError> {
-        let series = Self {
-            path: path.to_path_buf(),
-            entries,
-        };
+        let series = Self { path: path.to_path_buf(), entries };
         series.write()?;
         Ok(series)
     }
@@ -63,22 +57,10 @@ impl PvdSeries {
     /// file at the next successful append.
     pub fn append(&mut self, time: f64, file: &str, part: u32) -> Result<(), IoError> {
         if !time.is_finite() {
-            return Err(IoError::NonFiniteTime {
-                path: self.path.clone(),
-                time,
-            });
+            return Err(IoError::NonFiniteTime { path: self.path.clone(), time });
         }
-        let at = self
-            .entries
-            .partition_point(|e| (e.time, e.part) <= (time, part));
-        self.entries.insert(
-            at,
-            PvdEntry {
-                time,
-                file: file.replace('\\', "/"),
-                part,
-            },
-        );
+        let at = self.entries.partition_point(|e| (e.time, e.part) <= (time, part));
+        self.entries.insert(at, PvdEntry { time, file: file.replace('\\', "/"), part });
         self.write()
     }
 
@@ -191,10 +173,7 @@ mod tests {
 
         let dir = scratch_dir("pvd-nan");
         let mut series = PvdSeries::create(&dir.join("run.pvd")).unwrap();
-        assert!(matches!(
-            series.append(f64::NAN, "x.vtu", 0),
-            Err(IoError::NonFiniteTime { .. })
-        ));
+        assert!(matches!(series.append(f64::NAN, "x.vtu", 0), Err(IoError::NonFiniteTime { .. })));
         assert!(series.entries().is_empty());
         std::fs::remove_dir_all(&dir).unwrap();
     }

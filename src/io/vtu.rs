@@ -98,49 +98,29 @@ pub struct DataArray {
 impl DataArray {
     /// A scalar `Float64` array.
     pub fn scalars(name: impl Into<String>, values: Vec<f64>) -> Self {
-        Self {
-            name: name.into(),
-            components: 1,
-            data: ArrayData::F64(values),
-        }
+        Self { name: name.into(), components: 1, data: ArrayData::F64(values) }
     }
 
     /// A 3-component `Float64` vector array (velocity, displacement, ...).
     pub fn vectors(name: impl Into<String>, values: &[[f64; 3]]) -> Self {
-        Self {
-            name: name.into(),
-            components: 3,
-            data: ArrayData::F64(values.as_flattened().to_vec()),
-        }
+        Self { name: name.into(), components: 3, data: ArrayData::F64(values.as_flattened().to_vec()) }
     }
 
     /// A symmetric tensor array, components in VTK order
     /// `XX, YY, ZZ, XY, YZ, XZ`.
     pub fn symmetric_tensors(name: impl Into<String>, values: &[[f64; 6]]) -> Self {
-        Self {
-            name: name.into(),
-            components: 6,
-            data: ArrayData::F64(values.as_flattened().to_vec()),
-        }
+        Self { name: name.into(), components: 6, data: ArrayData::F64(values.as_flattened().to_vec()) }
     }
 
     /// A full tensor array, each tensor row-major
     /// (`XX, XY, XZ, YX, YY, YZ, ZX, ZY, ZZ`).
     pub fn tensors(name: impl Into<String>, values: &[[f64; 9]]) -> Self {
-        Self {
-            name: name.into(),
-            components: 9,
-            data: ArrayData::F64(values.as_flattened().to_vec()),
-        }
+        Self { name: name.into(), components: 9, data: ArrayData::F64(values.as_flattened().to_vec()) }
     }
 
     /// A scalar `Int32` array.
     pub fn integers(name: impl Into<String>, values: Vec<i32>) -> Self {
-        Self {
-            name: name.into(),
-            components: 1,
-            data: ArrayData::I32(values),
-        }
+        Self { name: name.into(), components: 1, data: ArrayData::I32(values) }
     }
 }
 
@@ -160,23 +140,13 @@ pub struct VtuPiece {
 impl VtuPiece {
     /// A particle cloud: one vertex cell per point, no data yet.
     pub fn point_cloud(points: Vec<[f64; 3]>) -> Self {
-        Self {
-            points,
-            cells: Cells::Vertices,
-            point_data: Vec::new(),
-            cell_data: Vec::new(),
-        }
+        Self { points, cells: Cells::Vertices, point_data: Vec::new(), cell_data: Vec::new() }
     }
 
     /// Poly-lines over `points` (each line a list of point indices), no data
     /// yet.
     pub fn poly_lines(points: Vec<[f64; 3]>, lines: Vec<Vec<u32>>) -> Self {
-        Self {
-            points,
-            cells: Cells::PolyLines(lines),
-            point_data: Vec::new(),
-            cell_data: Vec::new(),
-        }
+        Self { points, cells: Cells::PolyLines(lines), point_data: Vec::new(), cell_data: Vec::new() }
     }
 
     /// Adds a point-data array (builder style).
@@ -205,11 +175,9 @@ pub fn write_vtu(path: &Path, piece: &VtuPiece) -> Result<(), IoError> {
     let n_cells = piece.cells.count(n_points);
 
     let (connectivity, offsets, types): (Vec<i64>, Vec<i64>, Vec<u8>) = match &piece.cells {
-        Cells::Vertices => (
-            (0..n_points as i64).collect(),
-            (1..=n_points as i64).collect(),
-            vec![VTK_VERTEX; n_points],
-        ),
+        Cells::Vertices => {
+            ((0..n_points as i64).collect(), (1..=n_points as i64).collect(), vec![VTK_VERTEX; n_points])
+        }
         Cells::PolyLines(lines) => {
             let connectivity = lines.iter().flatten().map(|&i| i64::from(i)).collect();
             let offsets = lines
@@ -242,45 +210,16 @@ pub fn write_vtu(path: &Path, piece: &VtuPiece) -> Result<(), IoError> {
         /// after the `_` marker.
         offset: usize,
     }
-    let block = |section, vtk_type, name, components, bytes| Block {
-        section,
-        vtk_type,
-        name,
-        components,
-        bytes,
-        offset: 0,
-    };
+    let block =
+        |section, vtk_type, name, components, bytes| Block { section, vtk_type, name, components, bytes, offset: 0 };
     let mut blocks: Vec<Block> = Vec::new();
-    for (section, arrays) in [
-        (Section::PointData, &piece.point_data),
-        (Section::CellData, &piece.cell_data),
-    ] {
-        blocks.extend(arrays.iter().map(|a| {
-            block(
-                section,
-                a.data.vtk_type(),
-                &a.name,
-                a.components,
-                a.data.bytes(),
-            )
-        }));
+    for (section, arrays) in [(Section::PointData, &piece.point_data), (Section::CellData, &piece.cell_data)] {
+        blocks.extend(arrays.iter().map(|a| block(section, a.data.vtk_type(), &a.name, a.components, a.data.bytes())));
     }
     let point_bytes = bytemuck::cast_slice(&piece.points);
     blocks.push(block(Section::Points, "Float64", "Points", 3, point_bytes));
-    blocks.push(block(
-        Section::Cells,
-        "Int64",
-        "connectivity",
-        1,
-        bytemuck::cast_slice(&connectivity),
-    ));
-    blocks.push(block(
-        Section::Cells,
-        "Int64",
-        "offsets",
-        1,
-        bytemuck::cast_slice(&offsets),
-    ));
+    blocks.push(block(Section::Cells, "Int64", "connectivity", 1, bytemuck::cast_slice(&connectivity)));
+    blocks.push(block(Section::Cells, "Int64", "offsets", 1, bytemuck::cast_slice(&offsets)));
     blocks.push(block(Section::Cells, "UInt8", "types", 1, &types));
     let mut offset = 0;
     for block in &mut blocks {
@@ -335,29 +274,17 @@ fn validate(path: &Path, piece: &VtuPiece) -> Result<(), IoError> {
     if let Cells::PolyLines(lines) = &piece.cells {
         for (cell, line) in lines.iter().enumerate() {
             if line.is_empty() {
-                return Err(IoError::EmptyCell {
-                    path: path.to_path_buf(),
-                    cell,
-                });
+                return Err(IoError::EmptyCell { path: path.to_path_buf(), cell });
             }
             if let Some(&index) = line.iter().find(|&&i| i as usize >= n_points) {
-                return Err(IoError::CellIndex {
-                    path: path.to_path_buf(),
-                    cell,
-                    index,
-                    points: n_points,
-                });
+                return Err(IoError::CellIndex { path: path.to_path_buf(), cell, index, points: n_points });
             }
         }
     }
     for (arrays, tuples) in [(&piece.point_data, n_points), (&piece.cell_data, n_cells)] {
         let mut seen = HashSet::new();
         for array in arrays {
-            let invalid = |reason| IoError::InvalidName {
-                path: path.to_path_buf(),
-                name: array.name.clone(),
-                reason,
-            };
+            let invalid = |reason| IoError::InvalidName { path: path.to_path_buf(), name: array.name.clone(), reason };
             if array.name.trim().is_empty() {
                 return Err(invalid("empty name"));
             }
@@ -365,10 +292,7 @@ fn validate(path: &Path, piece: &VtuPiece) -> Result<(), IoError> {
                 return Err(invalid("duplicate name in the same data section"));
             }
             if array.components == 0 {
-                return Err(IoError::ZeroComponents {
-                    path: path.to_path_buf(),
-                    array: array.name.clone(),
-                });
+                return Err(IoError::ZeroComponents { path: path.to_path_buf(), array: array.name.clone() });
             }
             let expected = tuples * array.components;
             if array.data.len() != expected {
@@ -406,24 +330,15 @@ mod tests {
     impl ReadArray {
         fn f64s(&self) -> Vec<f64> {
             assert_eq!(self.vtk_type, "Float64", "{}", self.name);
-            self.raw
-                .chunks_exact(8)
-                .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
-                .collect()
+            self.raw.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().unwrap())).collect()
         }
         fn i64s(&self) -> Vec<i64> {
             assert_eq!(self.vtk_type, "Int64", "{}", self.name);
-            self.raw
-                .chunks_exact(8)
-                .map(|c| i64::from_le_bytes(c.try_into().unwrap()))
-                .collect()
+            self.raw.chunks_exact(8).map(|c| i64::from_le_bytes(c.try_into().unwrap())).collect()
         }
         fn i32s(&self) -> Vec<i32> {
             assert_eq!(self.vtk_type, "Int32", "{}", self.name);
-            self.raw
-                .chunks_exact(4)
-                .map(|c| i32::from_le_bytes(c.try_into().unwrap()))
-                .collect()
+            self.raw.chunks_exact(4).map(|c| i32::from_le_bytes(c.try_into().unwrap())).collect()
         }
     }
 
@@ -446,28 +361,16 @@ mod tests {
     fn read_vtu(path: &Path) -> ReadVtu {
         let bytes = std::fs::read(path).unwrap();
         let marker = b"<AppendedData encoding=\"raw\">";
-        let start = bytes
-            .windows(marker.len())
-            .position(|w| w == marker)
-            .expect("AppendedData");
+        let start = bytes.windows(marker.len()).position(|w| w == marker).expect("AppendedData");
         let underscore = start + bytes[start..].iter().position(|&b| b == b'_').unwrap();
         let data = &bytes[underscore + 1..];
         let header = String::from_utf8(bytes[..start + marker.len()].to_vec()).unwrap();
         let tail = b"\n  </AppendedData>\n</VTKFile>\n";
-        assert!(
-            bytes.ends_with(tail),
-            "file does not end with the closing tags"
-        );
+        assert!(bytes.ends_with(tail), "file does not end with the closing tags");
 
         let piece_tag = &header[header.find("<Piece ").unwrap()..];
-        let n_points = attribute(piece_tag, "NumberOfPoints")
-            .unwrap()
-            .parse()
-            .unwrap();
-        let n_cells = attribute(piece_tag, "NumberOfCells")
-            .unwrap()
-            .parse()
-            .unwrap();
+        let n_points = attribute(piece_tag, "NumberOfPoints").unwrap().parse().unwrap();
+        let n_cells = attribute(piece_tag, "NumberOfCells").unwrap().parse().unwrap();
 
         let mut arrays = Vec::new();
         let mut section = String::new();
@@ -490,21 +393,13 @@ mod tests {
                 section: section.clone(),
                 name: attribute(&tag, "Name").unwrap().to_string(),
                 vtk_type: attribute(&tag, "type").unwrap().to_string(),
-                components: attribute(&tag, "NumberOfComponents")
-                    .unwrap()
-                    .parse()
-                    .unwrap(),
+                components: attribute(&tag, "NumberOfComponents").unwrap().parse().unwrap(),
                 raw: data[offset + 8..offset + 8 + len].to_vec(),
             });
         }
         // The blocks exactly fill the appended section: no gaps, no overlap.
         assert_eq!(covered + tail.len(), data.len());
-        ReadVtu {
-            header,
-            n_points,
-            n_cells,
-            arrays,
-        }
+        ReadVtu { header, n_points, n_cells, arrays }
     }
 
     fn assert_bits_eq(found: &[f64], expected: &[f64]) {
@@ -533,19 +428,13 @@ mod tests {
     fn vertex_piece_round_trips_bit_for_bit() {
         let dir = scratch_dir("vtu-vertices");
         let n = 11;
-        let points: Vec<[f64; 3]> = (0..n)
-            .map(|i| [i as f64 * 0.1, awkward(i), -(i as f64).sqrt()])
-            .collect();
+        let points: Vec<[f64; 3]> = (0..n).map(|i| [i as f64 * 0.1, awkward(i), -(i as f64).sqrt()]).collect();
         let pressure: Vec<f64> = (0..n).map(|i| awkward(i + 3)).collect();
-        let velocity: Vec<[f64; 3]> = (0..n)
-            .map(|i| [i as f64, -2.0 * i as f64, std::f64::consts::PI * i as f64])
-            .collect();
-        let stress: Vec<[f64; 6]> = (0..n)
-            .map(|i| std::array::from_fn(|k| (10 * i + k) as f64 * 1.5e8))
-            .collect();
-        let deformation: Vec<[f64; 9]> = (0..n)
-            .map(|i| std::array::from_fn(|k| if k % 4 == 0 { 1.0 } else { i as f64 * 1e-3 }))
-            .collect();
+        let velocity: Vec<[f64; 3]> =
+            (0..n).map(|i| [i as f64, -2.0 * i as f64, std::f64::consts::PI * i as f64]).collect();
+        let stress: Vec<[f64; 6]> = (0..n).map(|i| std::array::from_fn(|k| (10 * i + k) as f64 * 1.5e8)).collect();
+        let deformation: Vec<[f64; 9]> =
+            (0..n).map(|i| std::array::from_fn(|k| if k % 4 == 0 { 1.0 } else { i as f64 * 1e-3 })).collect();
         let material: Vec<i32> = (0..n as i32).map(|i| i * 7 - 20).collect();
         let flags: Vec<i32> = (0..n as i32).map(|i| i32::MIN + i).collect();
         let piece = VtuPiece::point_cloud(points.clone())
@@ -565,20 +454,11 @@ mod tests {
         assert_eq!(vtu.get("Points", "Points").components, 3);
         assert_bits_eq(&vtu.get("PointData", "pressure").f64s(), &pressure);
         assert_eq!(vtu.get("PointData", "pressure").components, 1);
-        assert_bits_eq(
-            &vtu.get("PointData", "velocity").f64s(),
-            velocity.as_flattened(),
-        );
+        assert_bits_eq(&vtu.get("PointData", "velocity").f64s(), velocity.as_flattened());
         assert_eq!(vtu.get("PointData", "velocity").components, 3);
-        assert_bits_eq(
-            &vtu.get("PointData", "stress").f64s(),
-            stress.as_flattened(),
-        );
+        assert_bits_eq(&vtu.get("PointData", "stress").f64s(), stress.as_flattened());
         assert_eq!(vtu.get("PointData", "stress").components, 6);
-        assert_bits_eq(
-            &vtu.get("PointData", "F").f64s(),
-            deformation.as_flattened(),
-        );
+        assert_bits_eq(&vtu.get("PointData", "F").f64s(), deformation.as_flattened());
         assert_eq!(vtu.get("PointData", "F").components, 9);
         assert_eq!(vtu.get("PointData", "material").i32s(), material);
         assert_eq!(vtu.get("CellData", "flags").i32s(), flags);
@@ -610,21 +490,12 @@ mod tests {
         let vtu = read_vtu(&path);
         assert_eq!((vtu.n_points, vtu.n_cells), (7, 3));
         assert_bits_eq(&vtu.get("Points", "Points").f64s(), points.as_flattened());
-        assert_eq!(
-            vtu.get("Cells", "connectivity").i64s(),
-            vec![0, 1, 2, 3, 6, 5, 4]
-        );
+        assert_eq!(vtu.get("Cells", "connectivity").i64s(), vec![0, 1, 2, 3, 6, 5, 4]);
         assert_eq!(vtu.get("Cells", "offsets").i64s(), vec![4, 6, 7]);
         assert_eq!(vtu.get("Cells", "types").raw, vec![4u8; 3]);
-        assert_eq!(
-            vtu.get("PointData", "crack_id").i32s(),
-            vec![0, 0, 0, 0, 2, 1, 1]
-        );
+        assert_eq!(vtu.get("PointData", "crack_id").i32s(), vec![0, 0, 0, 0, 2, 1, 1]);
         assert_bits_eq(&vtu.get("CellData", "opening").f64s(), &opening);
-        assert_bits_eq(
-            &vtu.get("CellData", "tip_speed").f64s(),
-            tip_speed.as_flattened(),
-        );
+        assert_bits_eq(&vtu.get("CellData", "tip_speed").f64s(), tip_speed.as_flattened());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
@@ -671,8 +542,7 @@ mod tests {
     fn empty_piece_is_valid() {
         let dir = scratch_dir("vtu-empty");
         let path = dir.join("empty.vtu");
-        let piece =
-            VtuPiece::point_cloud(Vec::new()).with_point_data(DataArray::scalars("p", vec![]));
+        let piece = VtuPiece::point_cloud(Vec::new()).with_point_data(DataArray::scalars("p", vec![]));
         write_vtu(&path, &piece).unwrap();
         let vtu = read_vtu(&path);
         assert_eq!((vtu.n_points, vtu.n_cells), (0, 0));
@@ -687,60 +557,25 @@ mod tests {
         let cloud = || VtuPiece::point_cloud(vec![[0.0; 3]; 4]);
 
         let short = cloud().with_point_data(DataArray::scalars("p", vec![0.0; 3]));
-        assert!(matches!(
-            write_vtu(&path, &short),
-            Err(IoError::ArrayLength {
-                expected: 4,
-                found: 3,
-                ..
-            })
-        ));
+        assert!(matches!(write_vtu(&path, &short), Err(IoError::ArrayLength { expected: 4, found: 3, .. })));
         let cell_short = VtuPiece::poly_lines(vec![[0.0; 3]; 4], vec![vec![0, 1], vec![2, 3]])
             .with_cell_data(DataArray::scalars("c", vec![0.0; 4]));
-        assert!(matches!(
-            write_vtu(&path, &cell_short),
-            Err(IoError::ArrayLength {
-                expected: 2,
-                found: 4,
-                ..
-            })
-        ));
-        let zero = cloud().with_point_data(DataArray {
-            name: "z".into(),
-            components: 0,
-            data: ArrayData::F64(vec![]),
-        });
-        assert!(matches!(
-            write_vtu(&path, &zero),
-            Err(IoError::ZeroComponents { .. })
-        ));
+        assert!(matches!(write_vtu(&path, &cell_short), Err(IoError::ArrayLength { expected: 2, found: 4, .. })));
+        let zero = cloud().with_point_data(DataArray { name: "z".into(), components: 0, data: ArrayData::F64(vec![]) });
+        assert!(matches!(write_vtu(&path, &zero), Err(IoError::ZeroComponents { .. })));
         let duplicate = cloud()
             .with_point_data(DataArray::scalars("p", vec![0.0; 4]))
             .with_point_data(DataArray::integers("p", vec![0; 4]));
-        assert!(matches!(
-            write_vtu(&path, &duplicate),
-            Err(IoError::InvalidName { .. })
-        ));
+        assert!(matches!(write_vtu(&path, &duplicate), Err(IoError::InvalidName { .. })));
         let unnamed = cloud().with_point_data(DataArray::scalars(" ", vec![0.0; 4]));
-        assert!(matches!(
-            write_vtu(&path, &unnamed),
-            Err(IoError::InvalidName { .. })
-        ));
+        assert!(matches!(write_vtu(&path, &unnamed), Err(IoError::InvalidName { .. })));
         let out_of_range = VtuPiece::poly_lines(vec![[0.0; 3]; 2], vec![vec![0, 1], vec![1, 2]]);
         assert!(matches!(
             write_vtu(&path, &out_of_range),
-            Err(IoError::CellIndex {
-                cell: 1,
-                index: 2,
-                points: 2,
-                ..
-            })
+            Err(IoError::CellIndex { cell: 1, index: 2, points: 2, .. })
         ));
         let empty = VtuPiece::poly_lines(vec![[0.0; 3]; 2], vec![vec![]]);
-        assert!(matches!(
-            write_vtu(&path, &empty),
-            Err(IoError::EmptyCell { cell: 0, .. })
-        ));
+        assert!(matches!(write_vtu(&path, &empty), Err(IoError::EmptyCell { cell: 0, .. })));
         assert!(!path.exists());
         std::fs::remove_dir_all(&dir).unwrap();
     }

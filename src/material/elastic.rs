@@ -32,10 +32,7 @@ impl Constitutive for Elastic {
     fn update(&self, old: &PointState, k: &StepKinematics) -> PointState {
         let g = self.shear_modulus();
         let rate = identity() * (self.lame_lambda() * k.d.trace()) + k.d * (2.0 * g);
-        PointState {
-            tau: jaumann_update(&old.tau, &rate, &k.w, k.dt),
-            ..*old
-        }
+        PointState { tau: jaumann_update(&old.tau, &rate, &k.w, k.dt), ..*old }
     }
     fn density(&self) -> Real {
         self.density
@@ -60,13 +57,7 @@ mod tests {
     use crate::math::Tensor3;
 
     fn steel() -> Elastic {
-        Elastic {
-            density: 7850.0,
-            youngs_modulus: 200e9,
-            poisson_ratio: 0.3,
-            room_temperature: 293.0,
-            thermal: None,
-        }
+        Elastic { density: 7850.0, youngs_modulus: 200e9, poisson_ratio: 0.3, room_temperature: 293.0, thermal: None }
     }
 
     #[test]
@@ -74,10 +65,7 @@ mod tests {
         let m = steel();
         let mut d = Tensor3::zeros();
         d[(0, 0)] = 1.0;
-        let s = m.update(
-            &PointState::at_rest(293.0),
-            &StepKinematics { d, w: Tensor3::zeros(), dt: 1e-6 },
-        );
+        let s = m.update(&PointState::at_rest(293.0), &StepKinematics { d, w: Tensor3::zeros(), dt: 1e-6 });
         let expect = (m.lame_lambda() + 2.0 * m.shear_modulus()) * 1e-6;
         assert!((s.tau[(0, 0)] - expect).abs() < 1e-9 * expect);
         assert!((s.tau[(1, 1)] - m.lame_lambda() * 1e-6).abs() < 1e-3);

@@ -290,109 +290,38 @@ impl JohnsonCook {
     /// Check every parameter; returns all problems at once.
     pub fn validate(&self) -> Result<(), Vec<ParameterError>> {
         let mut errors = Vec::new();
-        let mut check =
-            |parameter: &'static str, value: Real, ok: bool, requirement: &'static str| {
-                if !(ok && value.is_finite()) {
-                    errors.push(ParameterError {
-                        parameter,
-                        value,
-                        requirement,
-                    });
-                }
-            };
+        let mut check = |parameter: &'static str, value: Real, ok: bool, requirement: &'static str| {
+            if !(ok && value.is_finite()) {
+                errors.push(ParameterError { parameter, value, requirement });
+            }
+        };
         check("density", self.density, self.density > 0.0, "> 0");
-        check(
-            "youngs_modulus",
-            self.youngs_modulus,
-            self.youngs_modulus > 0.0,
-            "> 0",
-        );
+        check("youngs_modulus", self.youngs_modulus, self.youngs_modulus > 0.0, "> 0");
         let nu = self.poisson_ratio;
         check("poisson_ratio", nu, nu > -1.0 && nu < 0.5, "in (-1, 0.5)");
-        check(
-            "yield_stress",
-            self.yield_stress,
-            self.yield_stress >= 0.0,
-            ">= 0",
-        );
-        check(
-            "hardening_modulus",
-            self.hardening_modulus,
-            self.hardening_modulus >= 0.0,
-            ">= 0",
-        );
-        check(
-            "hardening_exponent",
-            self.hardening_exponent,
-            self.hardening_exponent > 0.0,
-            "> 0",
-        );
-        check(
-            "rate_sensitivity",
-            self.rate_sensitivity,
-            self.rate_sensitivity > 0.0,
-            "> 0",
-        );
-        check(
-            "softening_exponent",
-            self.softening_exponent,
-            self.softening_exponent > 0.0,
-            "> 0",
-        );
-        check(
-            "room_temperature",
-            self.room_temperature,
-            self.room_temperature >= 0.0,
-            ">= 0",
-        );
+        check("yield_stress", self.yield_stress, self.yield_stress >= 0.0, ">= 0");
+        check("hardening_modulus", self.hardening_modulus, self.hardening_modulus >= 0.0, ">= 0");
+        check("hardening_exponent", self.hardening_exponent, self.hardening_exponent > 0.0, "> 0");
+        check("rate_sensitivity", self.rate_sensitivity, self.rate_sensitivity > 0.0, "> 0");
+        check("softening_exponent", self.softening_exponent, self.softening_exponent > 0.0, "> 0");
+        check("room_temperature", self.room_temperature, self.room_temperature >= 0.0, ">= 0");
         check(
             "melting_temperature",
             self.melting_temperature,
             self.melting_temperature > self.room_temperature,
             "> room_temperature",
         );
-        check(
-            "reference_strain_rate",
-            self.reference_strain_rate,
-            self.reference_strain_rate > 0.0,
-            "> 0",
-        );
-        check(
-            "specific_heat",
-            self.specific_heat,
-            self.specific_heat > 0.0,
-            "> 0",
-        );
+        check("reference_strain_rate", self.reference_strain_rate, self.reference_strain_rate > 0.0, "> 0");
+        check("specific_heat", self.specific_heat, self.specific_heat > 0.0, "> 0");
         let chi = self.taylor_quinney;
-        check(
-            "taylor_quinney",
-            chi,
-            (0.0..=1.0).contains(&chi),
-            "in [0, 1]",
-        );
+        check("taylor_quinney", chi, (0.0..=1.0).contains(&chi), "in [0, 1]");
         check("thermal_expansion", self.thermal_expansion, true, "finite");
-        check(
-            "conductivity",
-            self.conductivity,
-            self.conductivity >= 0.0,
-            ">= 0",
-        );
+        check("conductivity", self.conductivity, self.conductivity >= 0.0, ">= 0");
         let dc = &self.damage;
-        for (name, v) in [
-            ("d1", dc.d1),
-            ("d2", dc.d2),
-            ("d3", dc.d3),
-            ("d4", dc.d4),
-            ("d5", dc.d5),
-        ] {
+        for (name, v) in [("d1", dc.d1), ("d2", dc.d2), ("d3", dc.d3), ("d4", dc.d4), ("d5", dc.d5)] {
             check(name, v, true, "finite");
         }
-        check(
-            "theta",
-            self.theta,
-            (0.0..=1.0).contains(&self.theta),
-            "in [0, 1]",
-        );
+        check("theta", self.theta, (0.0..=1.0).contains(&self.theta), "in [0, 1]");
         if errors.is_empty() {
             Ok(())
         } else {
@@ -438,8 +367,7 @@ impl JohnsonCook {
     /// `g = (A + B ε̄ⁿ)(1 − T*ᵐ)` (× `(1 − D)` with damage coupling), Pa.
     /// SPEC §6, [RL10, Eqs. (2.46)–(2.72)].
     pub fn flow_stress(&self, eps_p: Real, temperature: Real, damage: Real) -> Real {
-        let strain = self.yield_stress
-            + self.hardening_modulus * eps_p.max(0.0).powf(self.hardening_exponent);
+        let strain = self.yield_stress + self.hardening_modulus * eps_p.max(0.0).powf(self.hardening_exponent);
         strain * self.thermal_factor(temperature) * self.damage_factor(damage)
     }
 
@@ -458,8 +386,7 @@ impl JohnsonCook {
         let thermal = self.thermal_factor(temperature);
         let dmg = self.damage_factor(damage);
         // ε̄ⁿ⁻¹ = ε̄ⁿ/ε̄ above the floor: one power instead of two.
-        let eps_n_minus_1 =
-            if eps >= PLASTIC_STRAIN_FLOOR { eps_n / eps } else { PLASTIC_STRAIN_FLOOR.powf(n - 1.0) };
+        let eps_n_minus_1 = if eps >= PLASTIC_STRAIN_FLOOR { eps_n / eps } else { PLASTIC_STRAIN_FLOOR.powf(n - 1.0) };
         let g_eps = self.hardening_modulus * n * eps_n_minus_1 * thermal * dmg;
         let t_star = self.homologous_temperature(temperature);
         let g_temp = if !(0.0..1.0).contains(&t_star) {
@@ -468,11 +395,7 @@ impl JohnsonCook {
             -m * t_star.max(HOMOLOGOUS_TEMPERATURE_FLOOR).powf(m - 1.0) * strain_part * dmg
                 / (self.melting_temperature - self.room_temperature)
         };
-        FlowStress {
-            g: strain_part * thermal * dmg,
-            g_eps,
-            g_temp,
-        }
+        FlowStress { g: strain_part * thermal * dmg, g_eps, g_temp }
     }
 
     /// The rate factor `τ̄/g` of steady flow at plastic rate `rate`: `1 + C ln(ε̄̇/ε̇₀)`
@@ -502,24 +425,15 @@ impl JohnsonCook {
             RateForm::Log => {
                 let x = ((tau_bar / g - 1.0) / c).min(MAX_RATE_EXPONENT);
                 let rate = rate0 * x.exp();
-                PlasticRate {
-                    rate,
-                    d_rate_d_tau: rate / (c * g),
-                }
+                PlasticRate { rate, d_rate_d_tau: rate / (c * g) }
             }
             RateForm::Power => {
                 if tau_bar < g {
-                    return PlasticRate {
-                        rate: 0.0,
-                        d_rate_d_tau: 0.0,
-                    };
+                    return PlasticRate { rate: 0.0, d_rate_d_tau: 0.0 };
                 }
                 let x = ((tau_bar / g).ln() / c).min(MAX_RATE_EXPONENT);
                 let rate = rate0 * x.exp_m1();
-                PlasticRate {
-                    rate,
-                    d_rate_d_tau: (rate + rate0) / (c * tau_bar),
-                }
+                PlasticRate { rate, d_rate_d_tau: (rate + rate0) / (c * tau_bar) }
             }
         }
     }
@@ -540,9 +454,7 @@ impl JohnsonCook {
     /// (Deviation 6).
     pub fn tangent_modulus(&self, tau_bar: Real, fs: &FlowStress) -> Real {
         let heat = self.heating_coefficient();
-        3.0 * self.shear_modulus()
-            + tau_bar * fs.g_eps / fs.g
-            + heat * tau_bar * tau_bar * fs.g_temp / fs.g
+        3.0 * self.shear_modulus() + tau_bar * fs.g_eps / fs.g + heat * tau_bar * tau_bar * fs.g_temp / fs.g
     }
 
     /// `χ/(ρ₀ C_p)`, K/Pa: temperature rise per unit plastic work.
@@ -596,29 +508,15 @@ impl JohnsonCook {
         let dev_d = deviator(&k.d);
         let rate = (2.0 / 3.0 * ddot(&dev_d, &dev_d)).sqrt();
         let mean = mean_stress(&old.tau) + k.dt * self.bulk_modulus() * k.d.trace();
-        PointState {
-            tau: identity() * mean,
-            eps_p: old.eps_p + k.dt * rate,
-            eps_p_rate: rate,
-            ..*old
-        }
+        PointState { tau: identity() * mean, eps_p: old.eps_p + k.dt * rate, eps_p_rate: rate, ..*old }
     }
 
     /// Deviation 8: a power-law step that starts below the flow stress.
-    fn update_power_below_flow_stress(
-        &self,
-        old: &PointState,
-        k: &StepKinematics,
-        fs: &FlowStress,
-    ) -> PointState {
+    fn update_power_below_flow_stress(&self, old: &PointState, k: &StepKinematics, fs: &FlowStress) -> PointState {
         let elastic = self.elastic_stress_rate(&k.d);
         let trial = jaumann_update(&old.tau, &elastic, &k.w, k.dt);
         if von_mises(&trial) <= fs.g {
-            return PointState {
-                tau: trial,
-                eps_p_rate: 0.0,
-                ..*old
-            };
+            return PointState { tau: trial, eps_p_rate: 0.0, ..*old };
         }
         // τ̄² along the explicit elastic path τ + s R is a s² + b s + c;
         // one root in (0, Δt] because c < 0 < a s² + b s + c at s = Δt.
@@ -628,20 +526,11 @@ impl JohnsonCook {
         let b = 3.0 * ddot(&s0, &r);
         let c = 1.5 * ddot(&s0, &s0) - fs.g * fs.g;
         let s_cross = (-2.0 * c / (b + (b * b - 4.0 * a * c).sqrt())).clamp(0.0, k.dt);
-        let mid = PointState {
-            tau: jaumann_update(&old.tau, &elastic, &k.w, s_cross),
-            ..*old
-        };
-        let at_threshold = PlasticRate {
-            rate: 0.0,
-            d_rate_d_tau: self.reference_strain_rate / (self.rate_sensitivity * fs.g),
-        };
+        let mid = PointState { tau: jaumann_update(&old.tau, &elastic, &k.w, s_cross), ..*old };
+        let at_threshold =
+            PlasticRate { rate: 0.0, d_rate_d_tau: self.reference_strain_rate / (self.rate_sensitivity * fs.g) };
         let mut new = self.flow_step(&mid, &k.d, &k.w, k.dt - s_cross, fs, &at_threshold);
-        new.eps_p_rate = if k.dt > 0.0 {
-            (new.eps_p - old.eps_p) / k.dt
-        } else {
-            0.0
-        };
+        new.eps_p_rate = if k.dt > 0.0 { (new.eps_p - old.eps_p) / k.dt } else { 0.0 };
         new
     }
 
@@ -668,7 +557,14 @@ impl JohnsonCook {
     }
 
     /// Deviation 12: the elastic trial step when flow cannot matter, else `None`.
-    fn negligible_flow_step(&self, old: &PointState, d: &Tensor3, w: &Tensor3, dt: Real, g: Real) -> Option<PointState> {
+    fn negligible_flow_step(
+        &self,
+        old: &PointState,
+        d: &Tensor3,
+        w: &Tensor3,
+        dt: Real,
+        g: Real,
+    ) -> Option<PointState> {
         if dt <= 0.0 {
             return None;
         }
@@ -732,11 +628,7 @@ impl JohnsonCook {
         let tau_bar = von_mises(&old.tau);
         if tau_bar <= 0.0 {
             // Only reached with d′ = 0 (flow_step): a purely volumetric step.
-            return PointState {
-                tau: jaumann_update(&old.tau, &elastic, w, dt),
-                eps_p_rate: 0.0,
-                ..*old
-            };
+            return PointState { tau: jaumann_update(&old.tau, &elastic, w, dt), eps_p_rate: 0.0, ..*old };
         }
         let P = deviator(&old.tau) * (3.0 * G / tau_bar);
         let p_d = ddot(&P, d);
@@ -777,24 +669,13 @@ impl JohnsonCook {
     /// pressure `3Kα ΔT` off the mean stress, and accumulate damage with the
     /// end-of-step triaxiality. SPEC §6 (flow rule, heating,
     /// damage), [RL10, Eqs. (2.46)–(2.72)].
-    fn radial_return(
-        &self,
-        old: &PointState,
-        elastic: &Tensor3,
-        w: &Tensor3,
-        dt: Real,
-        fs: &FlowStress,
-    ) -> PointState {
+    fn radial_return(&self, old: &PointState, elastic: &Tensor3, w: &Tensor3, dt: Real, fs: &FlowStress) -> PointState {
         let three_g = 3.0 * self.shear_modulus();
         let trial = jaumann_update(&old.tau, elastic, w, dt);
         let s_trial = deviator(&trial);
         let tau_trial = von_mises(&trial);
         if tau_trial <= 0.0 {
-            return PointState {
-                tau: trial,
-                eps_p_rate: 0.0,
-                ..*old
-            };
+            return PointState { tau: trial, eps_p_rate: 0.0, ..*old };
         }
         // r(τ̄_e) = Δt φ(τ̄_e, g(ε̄ + Δε̄)) − Δε̄ rises monotonically from r(0) < 0
         // to r(τ̄_tr) ≥ 0. Safeguarded Newton: a Newton step from the
@@ -843,8 +724,7 @@ impl JohnsonCook {
         let d_eps = (tau_trial - tau_end) / three_g;
         let tau_bar = von_mises(&old.tau);
         let d_temp = self.heating_coefficient() * 0.5 * (tau_bar + tau_end) * d_eps;
-        let mean =
-            mean_stress(&trial) - 3.0 * self.bulk_modulus() * self.thermal_expansion * d_temp;
+        let mean = mean_stress(&trial) - 3.0 * self.bulk_modulus() * self.thermal_expansion * d_temp;
         let rate = d_eps / dt;
         // End-of-step triaxiality, as befits backward Euler (and defined even
         // from a zero deviator, where the start-of-step one is 0/0).
@@ -895,10 +775,7 @@ impl Constitutive for JohnsonCook {
         self.room_temperature
     }
     fn thermal(&self) -> Option<ThermalProperties> {
-        Some(ThermalProperties {
-            specific_heat: self.specific_heat,
-            conductivity: self.conductivity,
-        })
+        Some(ThermalProperties { specific_heat: self.specific_heat, conductivity: self.conductivity })
     }
 }
 
@@ -922,13 +799,7 @@ mod tests {
     }
 
     fn state(tau: Tensor3, eps_p: Real, temperature: Real) -> PointState {
-        PointState {
-            tau,
-            eps_p,
-            eps_p_rate: 0.0,
-            temperature,
-            damage: 0.0,
-        }
+        PointState { tau, eps_p, eps_p_rate: 0.0, temperature, damage: 0.0 }
     }
 
     fn is_finite(s: &PointState) -> bool {
@@ -949,8 +820,7 @@ mod tests {
             for eps in [1e-3, 0.05, 0.3, 2.0] {
                 for t in [293.0, 500.0, 1200.0] {
                     let h = 1e-6 * eps;
-                    let fd = (m.flow_stress(eps + h, t, 0.0) - m.flow_stress(eps - h, t, 0.0))
-                        / (2.0 * h);
+                    let fd = (m.flow_stress(eps + h, t, 0.0) - m.flow_stress(eps - h, t, 0.0)) / (2.0 * h);
                     let g_eps = m.flow_stress_slopes(eps, t, 0.0).g_eps;
                     assert!(rel(g_eps, fd) < 1e-6, "eps {eps} T {t}: {g_eps} vs {fd}");
                 }
@@ -966,8 +836,7 @@ mod tests {
             for t_star in [0.01, 0.2, 0.5, 0.9, 0.99] {
                 let t = m.room_temperature + t_star * (m.melting_temperature - m.room_temperature);
                 let h = 1e-4;
-                let fd =
-                    (m.flow_stress(0.2, t + h, 0.3) - m.flow_stress(0.2, t - h, 0.3)) / (2.0 * h);
+                let fd = (m.flow_stress(0.2, t + h, 0.3) - m.flow_stress(0.2, t - h, 0.3)) / (2.0 * h);
                 let g_t = m.flow_stress_slopes(0.2, t, 0.3).g_temp;
                 assert!(rel(g_t, fd) < 1e-6, "T* {t_star}: {g_t} vs {fd}");
             }
@@ -984,14 +853,9 @@ mod tests {
                 }
                 let tau = ratio * g;
                 let h = 1e-7 * tau;
-                let fd =
-                    (m.plastic_rate(tau + h, g).rate - m.plastic_rate(tau - h, g).rate) / (2.0 * h);
+                let fd = (m.plastic_rate(tau + h, g).rate - m.plastic_rate(tau - h, g).rate) / (2.0 * h);
                 let f_tau = m.plastic_rate(tau, g).d_rate_d_tau;
-                assert!(
-                    rel(f_tau, fd) < 1e-5,
-                    "{:?} ratio {ratio}: {f_tau} vs {fd}",
-                    m.rate_form
-                );
+                assert!(rel(f_tau, fd) < 1e-5, "{:?} ratio {ratio}: {f_tau} vs {fd}", m.rate_form);
             }
         }
     }
@@ -1005,21 +869,14 @@ mod tests {
             for (eps, t, ratio) in [(0.05, 400.0, 1.05), (0.5, 900.0, 1.2), (1.5, 1500.0, 1.01)] {
                 let g0 = m.flow_stress(eps, t, 0.0);
                 let tau = ratio * g0;
-                let phi =
-                    |e: Real, temp: Real| m.plastic_rate(tau, m.flow_stress(e, temp, 0.0)).rate;
+                let phi = |e: Real, temp: Real| m.plastic_rate(tau, m.flow_stress(e, temp, 0.0)).rate;
                 let (he, ht) = (1e-6 * eps, 1e-3);
                 let f_eps = (phi(eps + he, t) - phi(eps - he, t)) / (2.0 * he);
                 let f_t = (phi(eps, t + ht) - phi(eps, t - ht)) / (2.0 * ht);
                 let f_tau = m.plastic_rate(tau, g0).d_rate_d_tau;
-                let general = 3.0 * m.shear_modulus()
-                    - f_eps / f_tau
-                    - m.heating_coefficient() * tau * f_t / f_tau;
+                let general = 3.0 * m.shear_modulus() - f_eps / f_tau - m.heating_coefficient() * tau * f_t / f_tau;
                 let h = m.tangent_modulus(tau, &m.flow_stress_slopes(eps, t, 0.0));
-                assert!(
-                    rel(h, general) < 1e-6,
-                    "{:?}: {h} vs {general}",
-                    m.rate_form
-                );
+                assert!(rel(h, general) < 1e-6, "{:?}: {h} vs {general}", m.rate_form);
             }
         }
     }
@@ -1040,12 +897,7 @@ mod tests {
         let m = weldox_460e();
         let base = |s: Real| 0.0705 + 1.732 * (-0.54 * s).exp();
         // Log law: 1 + D4 ln max(rate*, 1).
-        assert!(
-            rel(
-                m.failure_strain(0.4, 1e4, 293.0),
-                base(0.4) * (1.0 - 0.015 * 1e4f64.ln())
-            ) < 1e-14
-        );
+        assert!(rel(m.failure_strain(0.4, 1e4, 293.0), base(0.4) * (1.0 - 0.015 * 1e4f64.ln())) < 1e-14);
         assert!(rel(m.failure_strain(-0.2, 0.5, 293.0), base(-0.2)) < 1e-14);
         // Power law (Børvik): (1 + rate*)^D4.
         let p = weldox_460e_borvik();
@@ -1103,11 +955,7 @@ mod tests {
             assert!(s.eps_p > 0.1, "{:?}: {}", m.rate_form, s.eps_p);
             let tau_bar = von_mises(&s.tau);
             let g_now = m.flow_stress(s.eps_p, s.temperature, 0.0);
-            assert!(
-                tau_bar < 1.2 * g_now && tau_bar > g_now,
-                "{:?}: {tau_bar} vs {g_now}",
-                m.rate_form
-            );
+            assert!(tau_bar < 1.2 * g_now && tau_bar > g_now, "{:?}: {tau_bar} vs {g_now}", m.rate_form);
         }
     }
 
@@ -1128,21 +976,12 @@ mod tests {
     fn below_room_temperature_gives_room_temperature_strength() {
         let m = weldox_460e();
         let cold = m.room_temperature - 50.0;
-        assert_eq!(
-            m.flow_stress(0.2, cold, 0.0),
-            m.flow_stress(0.2, m.room_temperature, 0.0)
-        );
+        assert_eq!(m.flow_stress(0.2, cold, 0.0), m.flow_stress(0.2, m.room_temperature, 0.0));
         let fs = m.flow_stress_slopes(0.2, cold, 0.0);
         assert_eq!(fs.g_temp, 0.0);
         assert!(fs.g.is_finite() && fs.g_eps.is_finite());
-        assert_eq!(
-            m.failure_strain(0.3, 1e3, cold),
-            m.failure_strain(0.3, 1e3, m.room_temperature)
-        );
-        let s = m.update(
-            &state(uniaxial(1.1 * fs.g), 0.2, cold),
-            &kin(diag(1e4, 0.0, 0.0), Tensor3::zeros(), 1e-8),
-        );
+        assert_eq!(m.failure_strain(0.3, 1e3, cold), m.failure_strain(0.3, 1e3, m.room_temperature));
+        let s = m.update(&state(uniaxial(1.1 * fs.g), 0.2, cold), &kin(diag(1e4, 0.0, 0.0), Tensor3::zeros(), 1e-8));
         assert!(is_finite(&s) && s.eps_p > 0.2 && s.temperature > cold);
     }
 
@@ -1160,13 +999,7 @@ mod tests {
         w[(1, 0)] = -2e3;
         let dt = 1e-8;
         for t in [m.melting_temperature, m.melting_temperature + 10.0] {
-            let old = PointState {
-                tau,
-                eps_p: 0.5,
-                eps_p_rate: 1e4,
-                temperature: t,
-                damage: 0.4,
-            };
+            let old = PointState { tau, eps_p: 0.5, eps_p_rate: 1e4, temperature: t, damage: 0.4 };
             let new = m.update(&old, &kin(d, w, dt));
             assert!(is_finite(&new));
             assert!(von_mises(&new.tau) <= 1e-15 * mean_stress(&new.tau).abs());
@@ -1195,11 +1028,7 @@ mod tests {
                 let next = m.update(&s, &k);
                 assert!(is_finite(&next), "{:?} step {step}", m.rate_form);
                 let tau_bar = von_mises(&next.tau);
-                assert!(
-                    tau_bar <= previous && tau_bar > 0.0,
-                    "{:?} step {step}: {tau_bar}",
-                    m.rate_form
-                );
+                assert!(tau_bar <= previous && tau_bar > 0.0, "{:?} step {step}: {tau_bar}", m.rate_form);
                 assert!(next.eps_p >= s.eps_p);
                 if step == 0 {
                     // The fallback's backward-Euler return: radial, and on the
@@ -1207,10 +1036,7 @@ mod tests {
                     let d_eps = next.eps_p - s.eps_p;
                     assert!((tau_bar + 3.0 * m.shear_modulus() * d_eps - tau0).abs() < 1e-9 * tau0);
                     let g_new = m.flow_stress(next.eps_p, 293.0, 0.0);
-                    assert!(
-                        rel(tau_bar, g_new * m.rate_factor(d_eps / k.dt)) < 1e-9,
-                        "{tau_bar}"
-                    );
+                    assert!(rel(tau_bar, g_new * m.rate_factor(d_eps / k.dt)) < 1e-9, "{tau_bar}");
                     assert!(tau_bar < m.max_overstress_ratio() * g_new);
                 }
                 previous = tau_bar;
@@ -1219,11 +1045,7 @@ mod tests {
             // Below the cap the relaxation goes at the law's own (finite) pace.
             let g_end = m.flow_stress(s.eps_p, 293.0, 0.0);
             let ratio = previous / g_end;
-            assert!(
-                ratio > 1.0 && ratio < m.max_overstress_ratio(),
-                "{:?}: {ratio}",
-                m.rate_form
-            );
+            assert!(ratio > 1.0 && ratio < m.max_overstress_ratio(), "{:?}: {ratio}", m.rate_form);
         }
     }
 
@@ -1259,18 +1081,11 @@ mod tests {
         // ε̄̇_θ = ε̄̇ + θΔt f_τ P:d (Deviation 6), not a division by 1 + ξ < 1.
         let dt = 1e-7;
         let tb = 1.01 * fs_b.g;
-        let new = soft.update(
-            &state(uniaxial(tb), 0.3, t_b),
-            &kin(diag(1e3, 0.0, 0.0), Tensor3::zeros(), dt),
-        );
+        let new = soft.update(&state(uniaxial(tb), 0.3, t_b), &kin(diag(1e3, 0.0, 0.0), Tensor3::zeros(), dt));
         let pr = soft.plastic_rate(tb, fs_b.g);
         let p_d = 2.0 * soft.shear_modulus() * 1e3; // P:d for uniaxial n̂ and d
         let want = pr.rate + 0.5 * dt * pr.d_rate_d_tau * p_d;
-        assert!(
-            rel(new.eps_p_rate, want) < 1e-12,
-            "{} vs {want}",
-            new.eps_p_rate
-        );
+        assert!(rel(new.eps_p_rate, want) < 1e-12, "{} vs {want}", new.eps_p_rate);
     }
 
     #[test]
@@ -1385,10 +1200,7 @@ mod tests {
         let want = elastic.update(&old, &k);
         assert!(von_mises(&new.tau) < g);
         assert!((new.tau - want.tau).norm() <= 1e-12 * want.tau.norm());
-        assert_eq!(
-            (new.eps_p, new.eps_p_rate, new.temperature, new.damage),
-            (0.2, 0.0, 400.0, 0.0)
-        );
+        assert_eq!((new.eps_p, new.eps_p_rate, new.temperature, new.damage), (0.2, 0.0, 400.0, 0.0));
     }
 
     /// One step whose elastic predictor crosses `g` (from `τ̄ = g(1 − aC)`
@@ -1421,11 +1233,7 @@ mod tests {
         };
         let (e1, e2) = (error(0.4), error(0.2));
         assert!(e2 < 0.1, "{e2}");
-        assert!(
-            (e1 / e2 - 2.0).abs() < 0.3,
-            "order {} ({e1}, {e2})",
-            e1 / e2
-        );
+        assert!((e1 / e2 - 2.0).abs() < 0.3, "order {} ({e1}, {e2})", e1 / e2);
     }
 
     #[test]
@@ -1437,10 +1245,7 @@ mod tests {
         assert!(rel(m.flow_stress(0.2, 500.0, 0.4), 0.6 * g0) < 1e-14);
         assert_eq!(m.flow_stress(0.2, 500.0, 1.3), 0.0);
         // A fully damaged coupled point carries no deviatoric stress.
-        let old = PointState {
-            damage: 1.0,
-            ..state(uniaxial(g0), 0.2, 500.0)
-        };
+        let old = PointState { damage: 1.0, ..state(uniaxial(g0), 0.2, 500.0) };
         let new = m.update(&old, &kin(diag(1e3, 0.0, 0.0), Tensor3::zeros(), 1e-7));
         assert_eq!(von_mises(&new.tau), 0.0);
     }
@@ -1462,10 +1267,7 @@ mod tests {
             let dt_heat = s.temperature - 293.0;
             assert!(dt_heat > 50.0);
             let want = -3.0 * m.bulk_modulus() * alpha * dt_heat;
-            assert!(
-                (mean_stress(&s.tau) - want).abs() <= 1e-9 * want.abs().max(1.0),
-                "α {alpha}"
-            );
+            assert!((mean_stress(&s.tau) - want).abs() <= 1e-9 * want.abs().max(1.0), "α {alpha}");
         }
     }
 
@@ -1474,10 +1276,7 @@ mod tests {
         let mut m = weldox_460e();
         m.taylor_quinney = 0.0;
         let g = m.flow_stress(0.2, 293.0, 0.0);
-        let new = m.update(
-            &state(uniaxial(1.1 * g), 0.2, 293.0),
-            &kin(diag(1e4, 0.0, 0.0), Tensor3::zeros(), 1e-7),
-        );
+        let new = m.update(&state(uniaxial(1.1 * g), 0.2, 293.0), &kin(diag(1e4, 0.0, 0.0), Tensor3::zeros(), 1e-7));
         assert!(new.eps_p > 0.2);
         assert_eq!(new.temperature, 293.0);
     }
@@ -1490,15 +1289,7 @@ mod tests {
         m.melting_temperature = 200.0;
         m.theta = 1.5;
         m.damage.d2 = Real::NAN;
-        let names: Vec<&str> = m
-            .validate()
-            .unwrap_err()
-            .iter()
-            .map(|e| e.parameter)
-            .collect();
-        assert_eq!(
-            names,
-            ["poisson_ratio", "melting_temperature", "d2", "theta"]
-        );
+        let names: Vec<&str> = m.validate().unwrap_err().iter().map(|e| e.parameter).collect();
+        assert_eq!(names, ["poisson_ratio", "melting_temperature", "d2", "theta"]);
     }
 }

@@ -46,13 +46,7 @@ pub fn weldox_460e() -> JohnsonCook {
         taylor_quinney: 0.9,
         thermal_expansion: 11.2e-6,
         conductivity: 50.0,
-        damage: DamageConstants {
-            d1: 0.0705,
-            d2: 1.732,
-            d3: -0.54,
-            d4: -0.015,
-            d5: 0.0,
-        },
+        damage: DamageConstants { d1: 0.0705, d2: 1.732, d3: -0.54, d4: -0.015, d5: 0.0 },
         damage_coupling: false,
         theta: JohnsonCook::DEFAULT_THETA,
     }

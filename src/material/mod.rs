@@ -32,13 +32,7 @@ pub struct PointState {
 impl PointState {
     /// A stress-free, undamaged point at temperature `t0`.
     pub fn at_rest(t0: Real) -> Self {
-        Self {
-            tau: Tensor3::zeros(),
-            eps_p: 0.0,
-            eps_p_rate: 0.0,
-            temperature: t0,
-            damage: 0.0,
-        }
+        Self { tau: Tensor3::zeros(), eps_p: 0.0, eps_p_rate: 0.0, temperature: t0, damage: 0.0 }
     }
 }
 
@@ -135,10 +129,7 @@ impl Constitutive for Material {
 /// take them from.
 #[inline]
 pub fn isotropic_moduli(youngs_modulus: Real, poisson_ratio: Real) -> (Real, Real) {
-    (
-        youngs_modulus / (3.0 * (1.0 - 2.0 * poisson_ratio)),
-        youngs_modulus / (2.0 * (1.0 + poisson_ratio)),
-    )
+    (youngs_modulus / (3.0 * (1.0 - 2.0 * poisson_ratio)), youngs_modulus / (2.0 * (1.0 + poisson_ratio)))
 }
 
 /// Objective (Jaumann) update `τ ← τ + Δt (τ^∇ + w τ − τ w)` (SPEC §6, last

@@ -87,23 +87,14 @@ fn row_at(
         let (phi, dphi) = (phi * volume[i], dphi * volume[i]);
         let z = Z * inv_l;
         let p = Vector4::new(1.0, z.x, z.y, z.x * z.y);
-        let dp = [
-            Vector4::new(0.0, inv_l, 0.0, z.y * inv_l),
-            Vector4::new(0.0, 0.0, inv_l, z.x * inv_l),
-        ];
+        let dp = [Vector4::new(0.0, inv_l, 0.0, z.y * inv_l), Vector4::new(0.0, 0.0, inv_l, z.x * inv_l)];
         let ppt = p * p.transpose();
         M += ppt * phi;
         for k in 0..2 {
             dM[k] += (dp[k] * p.transpose() + p * dp[k].transpose()) * phi + ppt * dphi[k];
         }
     }
-    let singular = |condition: Real| ShapeError::SingularMoment {
-        point,
-        x: x.x,
-        y: x.y,
-        neighbours: n,
-        condition,
-    };
+    let singular = |condition: Real| ShapeError::SingularMoment { point, x: x.x, y: x.y, neighbours: n, condition };
     if n < 4 {
         return Err(singular(Real::INFINITY));
     }
@@ -125,10 +116,7 @@ fn row_at(
         let (phi, dphi) = (phi * volume[iu], dphi * volume[iu]);
         let z = Z * inv_l;
         let p = Vector4::new(1.0, z.x, z.y, z.x * z.y);
-        let dp = [
-            Vector4::new(0.0, inv_l, 0.0, z.y * inv_l),
-            Vector4::new(0.0, 0.0, inv_l, z.x * inv_l),
-        ];
+        let dp = [Vector4::new(0.0, inv_l, 0.0, z.y * inv_l), Vector4::new(0.0, 0.0, inv_l, z.x * inv_l)];
         let bp = b.dot(&p);
         let value = bp * phi;
         let mut grad = Vec2::zeros();
