@@ -129,12 +129,12 @@ fn check_invariants(m: &Model, growth: &CrackGrowth, before: &Invariants, what: 
         .flat_map(|c| c.vertices.windows(2).map(|w| (w[0].x0, w[1].x0)).collect::<Vec<_>>())
         .collect();
     let crossing = |table: &ShapeTable, points: &[Vec2], label: &str| {
-        for r in 0..table.rows() {
+        for (r, point) in points.iter().enumerate().take(table.rows()) {
             for k in table.range(r) {
                 let i = table.index[k] as usize;
                 for (a, b) in &segs {
                     assert!(
-                        !strictly_crosses(a, b, &points[r], &p.x0[i]),
+                        !strictly_crosses(a, b, point, &p.x0[i]),
                         "{what}: {label} row {r} uses particle {i} across crack segment {a:?}-{b:?}"
                     );
                 }
