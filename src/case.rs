@@ -224,7 +224,7 @@ pub struct TimeSpec {
     /// stencil and the stiffening of compressed material.
     #[serde(default = "half")]
     pub safety_factor: Real,
-    /// A fixed step, s, overriding the CFL rule ([RL10] used 4e-9 s).
+    /// A fixed step, s, overriding the CFL rule (\[RL10\] used 4e-9 s).
     #[serde(default)]
     pub fixed_dt: Option<Real>,
 }

@@ -1,11 +1,11 @@
 //! Particle and quadrature-point generators for rectangular bodies
-//! (SPEC §4, [RL10] §5.2).
+//! (SPEC §4, \[RL10\] §5.2).
 //!
 //! Spacing along x is graded: uniform and finest within a zone around a given
 //! point, then growing geometrically up to a coarsest spacing; through the
 //! thickness (y) it is uniform. Background cells join neighbouring particle
 //! columns and rows and carry n×n Gauss points each — with 24 × 480 particles
-//! this gives [RL10]'s coarse model exactly (11,520 particles, 44,068 points).
+//! this gives \[RL10\]'s coarse model exactly (11,520 particles, 44,068 points).
 
 use crate::geometry::GeometryMode;
 use crate::math::{Real, Vec2};
@@ -48,7 +48,7 @@ pub struct RectangleGrid {
     /// with margin on graded grids (SPEC §3).
     #[serde(default = "two")]
     pub support_factor: Real,
-    /// Gauss points per cell direction (1–4). Default 2, as [RL10].
+    /// Gauss points per cell direction (1–4). Default 2, as \[RL10\].
     #[serde(default = "gauss_default")]
     pub gauss: usize,
 }
