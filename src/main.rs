@@ -478,8 +478,15 @@ fn drive(
         qp_rate,
         s.steps as f64 / s.loop_wall.as_secs_f64().max(1e-9)
     );
-    for (name, v) in &s.rigid_velocities {
-        println!("  rigid body {name}: final velocity ({:.2}, {:.2}) m/s", v[0], v[1]);
+    for ((name, v), (_, last)) in s.rigid_velocities.iter().zip(&s.last_contacts) {
+        let contact = match last {
+            Some(t) if s.time - t > 1e-9 => {
+                format!("last contact at {:.2} us (its residual velocity if none follows)", t * 1e6)
+            }
+            Some(_) => "still in contact at the end".to_string(),
+            None => "never in contact".to_string(),
+        };
+        println!("  rigid body {name}: final velocity ({:.2}, {:.2}) m/s; {contact}", v[0], v[1]);
     }
     for (id, nucleated, arrested) in &s.cracks {
         match arrested {

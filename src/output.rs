@@ -429,3 +429,23 @@ pub fn plot_fields(sim: &Simulation, dir: &Path) -> Result<Vec<PathBuf>, crate::
     }
     Ok(written)
 }
+
+/// When each rigid body was last in contact, from the run's `history.csv`
+/// (the `NAME_contacts` column): `(name, time of the last history row with
+/// contacts, if any)`. Read from the history rather than tracked in the
+/// loop, so it is right for resumed runs too. The velocity a body keeps once
+/// its contacts have vanished is what experimenters call its residual
+/// velocity.
+pub fn last_contact_times(dir: &Path, rigid_names: &[String]) -> Result<Vec<(String, Option<Real>)>, IoError> {
+    let table = crate::io::HistoryTable::read(&dir.join("history.csv"))?;
+    let time = table.column("time").unwrap_or_default().to_vec();
+    Ok(rigid_names
+        .iter()
+        .map(|n| {
+            let last = table
+                .column(&format!("{n}_contacts"))
+                .and_then(|c| c.iter().zip(&time).filter(|(c, _)| **c > 0.0).map(|(_, t)| *t).last());
+            (n.clone(), last)
+        })
+        .collect())
+}

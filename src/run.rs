@@ -94,6 +94,8 @@ pub struct RunSummary {
     pub separation: Option<Real>,
     /// Velocity of each rigid body at the end, (name, (vx, vy)) m/s.
     pub rigid_velocities: Vec<(String, [Real; 2])>,
+    /// Time of each rigid body's last contact (history rows), s.
+    pub last_contacts: Vec<(String, Option<Real>)>,
 }
 
 /// Why a run stopped.
@@ -439,15 +441,18 @@ fn time_loop(
         ),
         None => (Vec::new(), None),
     };
-    let rigid_velocities = sim
+    let rigid_velocities: Vec<(String, [Real; 2])> = sim
         .contact
         .as_ref()
         .map(|c| c.bodies.iter().map(|b| (b.name.clone(), [b.velocity.x, b.velocity.y])).collect())
         .unwrap_or_default();
+    let names: Vec<String> = rigid_velocities.iter().map(|(n, _)| n.clone()).collect();
+    let last_contacts = crate::output::last_contact_times(&cfg.out_dir, &names)?;
     Ok(RunSummary {
         cracks,
         separation,
         rigid_velocities,
+        last_contacts,
         plots,
         particles: sim.model.particles.len(),
         quadrature_points: sim.model.quad.len(),
