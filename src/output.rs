@@ -449,3 +449,22 @@ pub fn last_contact_times(dir: &Path, rigid_names: &[String]) -> Result<Vec<(Str
         })
         .collect())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn last_contact_time_is_the_last_row_with_contacts() {
+        let dir = std::env::temp_dir().join(format!("plugsim-last-contact-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut h = HistoryWriter::create(&dir.join("history.csv"), &["time", "p_contacts", "q_contacts"]).unwrap();
+        for (t, p) in [(0.0, 0.0), (1.0, 3.0), (2.0, 0.0), (3.0, 2.0), (4.0, 0.0)] {
+            h.write_row(&[t, p, 0.0]).unwrap();
+        }
+        drop(h);
+        let got = last_contact_times(&dir, &["p".into(), "q".into()]).unwrap();
+        assert_eq!(got, vec![("p".to_string(), Some(3.0)), ("q".to_string(), None)]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
