@@ -24,6 +24,11 @@ pub const BUILTIN_CASES: &[(&str, &str, &str)] = &[
         "the same with [RL10]'s fine discretization (48 rows, 46,032 particles)",
     ),
     (
+        "borvik-1-axisymmetric",
+        include_str!("../cases/borvik-1-axisymmetric.toml"),
+        "Borvik Case I (298 m/s, 11.1 mm Weldox), axisymmetric (197 g cylinder), coarse, effective-strain cracks",
+    ),
+    (
         "borvik-1-nofracture",
         include_str!("../cases/borvik-1-nofracture.toml"),
         "Borvik Case I (298 m/s, 11.1 mm Weldox), plane strain, coarse, no fracture",

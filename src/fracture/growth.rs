@@ -26,8 +26,25 @@ pub const EXTENSION_PER_OFFSET: Real = 5.0;
 pub const MAX_SURFACE_OBLIQUITY: Real = 40.0;
 
 /// Smallest lumped mass of a re-lumped particle, as a fraction of its
-/// nodal mass `ρ ΔV_I` (see the module doc of [`crate::fracture`]).
+/// nodal mass `ρ ΔV_I` (times `2πR` in axisymmetry: [`nodal_mass`]; see the
+/// module doc of [`crate::fracture`]).
 pub const MASS_FLOOR: Real = 0.5;
+
+/// Nodal mass `ρ ΔV_I` of particle `i` from its nodal volume, in the units of
+/// the lumped masses: per unit depth in plane strain, and revolved in
+/// axisymmetry, where `ΔV_I` is an area: `ρ ΔV_I 2π max(R_I, h_I/4)`. On the
+/// axis the cell `[0, h/2]` revolves about its own edge and its volume is
+/// `ΔV_I 2π h/4`, hence the `h/4` (`mass_floor_is_revolved_in_axisymmetry`).
+pub fn nodal_mass(model: &Model, i: usize) -> Real {
+    let p = &model.particles;
+    let rho = model.materials[p.body[i] as usize].density();
+    let x = p.x0[i];
+    let factor = match model.mode {
+        GeometryMode::PlaneStrain => 1.0,
+        GeometryMode::Axisymmetric => model.mode.volume_factor(&Vec2::new(x.x.max(0.25 * p.spacing[i]), x.y)),
+    };
+    rho * p.volume[i] * factor
+}
 
 /// A segment may not pass within this fraction of a particle's spacing of
 /// a particle it does not end at.
@@ -421,7 +438,9 @@ impl CrackGrowth {
         let mut cores: Vec<(Real, usize)> = (0..model.particles.len())
             .filter(|&i| {
                 let f = model.particles.flags[i];
-                f.has(ParticleFlags::SLAVE) && !f.has(ParticleFlags::CRACK_FACE)
+                // The axis is a boundary of the r-z section but no surface
+                // of the body: no crack starts there.
+                f.has(ParticleFlags::SLAVE) && !f.has(ParticleFlags::CRACK_FACE) && !f.has(ParticleFlags::ON_AXIS)
             })
             .map(|i| (self.criterion_value(model, i), i))
             .filter(|&(v, _)| v >= critical)
@@ -687,8 +706,7 @@ impl CrackGrowth {
         let mut floored = Vec::new();
         for &i in &touched {
             let m = model.lumped_mass(i);
-            let rho = model.materials[model.particles.body[i] as usize].density();
-            let floor = MASS_FLOOR * rho * model.particles.volume[i];
+            let floor = MASS_FLOOR * nodal_mass(model, i);
             if m < floor {
                 floored.push(i);
             }

@@ -34,7 +34,10 @@
 //!   in decreasing order of value, each becomes a core unless it lies on a
 //!   crack face or within `nucleation_distance_factor × h` of an existing
 //!   crack path (one crack per stress concentration; the neighbours of a
-//!   core meet the criterion a few steps later). The initial direction is
+//!   core meet the criterion a few steps later), or on the axis in
+//!   axisymmetry (flagged surface and slave as an edge of the r-z section,
+//!   but no surface of the body; `no_crack_nucleates_on_the_axis`,
+//!   `axisymmetric_crack_starts_at_the_corner_not_on_the_axis`). The initial direction is
 //!   set by the tip: the particle within `R` of the core that meets the
 //!   criterion with the largest value, not on a surface (a first segment
 //!   along the free surface would cut nothing), not on a crack face. No
@@ -89,7 +92,10 @@
 //!   points and its row-sum mass can come out negative (the Borvik
 //!   plane-strain run hit −0.05 kg/m at the first arrest). A re-lumped
 //!   mass is therefore held at no less than `MASS_FLOOR = ½` of the
-//!   particle's nodal mass `ρ ΔV_I`, the extra taken from the other
+//!   particle's nodal mass `ρ ΔV_I` (revolved in axisymmetry, where
+//!   `ΔV_I` is an area: `ρ ΔV_I 2π max(R_I, h_I/4)`; the Borvik
+//!   axisymmetric run, floored at `ρ ΔV_I`, took more than the
+//!   neighbours' whole mass and left a negative one), the extra taken from the other
 //!   re-lumped particles in proportion to their masses (total mass exact);
 //!   momentum is then restored as above. Such particles' masses are no
 //!   longer row sums (`arrest_at_the_far_surface_without_running_along_it`
