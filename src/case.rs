@@ -652,7 +652,10 @@ impl Case {
         };
         let velocity = Vec2::new(rb.velocity[0], rb.velocity[1]);
         let body = RigidBody::new(rb.name.clone(), outline, position, velocity, mass)?;
-        Ok(if rb.prescribed { body.with_prescribed_velocity(velocity) } else { body })
+        let body = if rb.prescribed { body.with_prescribed_velocity(velocity) } else { body };
+        // In axisymmetry a body is a body of revolution about the axis: it
+        // cannot move radially.
+        Ok(if self.geometry.mode == GeometryMode::Axisymmetric { body.held_on_axis() } else { body })
     }
 
     /// All rigid bodies.

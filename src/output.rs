@@ -444,7 +444,7 @@ pub fn last_contact_times(dir: &Path, rigid_names: &[String]) -> Result<Vec<(Str
         .map(|n| {
             let last = table
                 .column(&format!("{n}_contacts"))
-                .and_then(|c| c.iter().zip(&time).filter(|(c, _)| **c > 0.0).map(|(_, t)| *t).last());
+                .and_then(|c| c.iter().zip(&time).rev().find(|(c, _)| **c > 0.0).map(|(_, t)| *t));
             (n.clone(), last)
         })
         .collect())

@@ -44,6 +44,10 @@ pub struct RigidBody {
     /// When set, the body moves at this velocity whatever the contact force
     /// (a driven punch, a fixed wall); the reaction is still reported.
     pub prescribed_velocity: Option<Vec2>,
+    /// Held on the symmetry axis (axisymmetry): the radial (x) component of
+    /// its velocity stays zero whatever the radial contact force, since in
+    /// the r–z half section the forces on the mirrored half are missing.
+    pub on_axis: bool,
 }
 
 impl RigidBody {
@@ -101,7 +105,16 @@ impl RigidBody {
             velocity,
             mass,
             prescribed_velocity: None,
+            on_axis: false,
         })
+    }
+
+    /// The same body, held on the symmetry axis: no radial motion (its
+    /// radial velocity is zeroed).
+    pub fn held_on_axis(mut self) -> Self {
+        self.on_axis = true;
+        self.velocity.x = 0.0;
+        self
     }
 
     /// The same body, driven at a prescribed velocity (also set as its
@@ -170,6 +183,9 @@ impl RigidBody {
             Some(v) => v,
             None => self.velocity + force * (dt / self.mass),
         };
+        if self.on_axis {
+            self.velocity.x = 0.0;
+        }
         self.position += self.velocity * dt;
     }
 
