@@ -461,6 +461,10 @@ fn axisymmetric_crack_starts_at_the_corner_not_on_the_axis() {
         assert!(c.vertices.len() >= 4, "propagated: {:?}", c.vertices);
     }
     assert!(sim.model.particles.mass.iter().all(|&m| m > 0.0), "positive masses");
+    // a body of revolution cannot move radially (held on the axis)
+    let projectile = &sim.contact.as_ref().unwrap().bodies[0];
+    assert_eq!(projectile.velocity.x, 0.0);
+    assert!(projectile.velocity.y > -298.0, "the projectile slowed: {}", projectile.velocity.y);
 }
 
 /// The same case gives the same crack path, bit for bit, on 1 and 2 threads.
