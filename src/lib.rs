@@ -25,3 +25,4 @@ pub mod run;
 pub mod shape;
 pub mod step;
 pub mod thermal;
+pub mod validation;

@@ -57,6 +57,16 @@ enum Command {
     },
     /// List the built-in cases.
     Cases,
+    /// Run Borvik's plugging cases and compare residual velocities with the
+    /// experiments and the paper (writes validation.md, validation.csv, plots).
+    Validate {
+        /// Output directory for the runs and the report.
+        #[arg(long, default_value = "runs/validation")]
+        out: PathBuf,
+        /// Only the rows whose id contains this text (e.g. case-1, axisymmetric).
+        #[arg(long)]
+        only: Option<String>,
+    },
     /// Benchmark fixed workloads: shape functions, material kernel, force
     /// assembly, whole steps (1 and all threads), optionally whole cases.
     Bench {
@@ -163,6 +173,7 @@ fn dispatch(cmd: Command) -> Result<()> {
             Ok(())
         }
         Command::Bench { case, steps, whole, set } => bench(&case, steps, whole, &set),
+        Command::Validate { out, only } => validate(&out, only.as_deref()),
         Command::MaterialPoint { material, case_file, path, rate, strain, dt, out } => {
             material_point(&material, case_file.as_deref(), path, rate, strain, dt, &out)
         }
@@ -257,6 +268,49 @@ fn material_point(
     for p in plots {
         println!("  wrote {}", p.display());
     }
+    Ok(())
+}
+
+fn validate(out: &Path, only: Option<&str>) -> Result<()> {
+    use plugsim::validation::{coarse_rows, run_row, table, velocity_plot, EXPERIMENTS};
+    let rows: Vec<_> = coarse_rows().into_iter().filter(|r| only.is_none_or(|o| r.id.contains(o))).collect();
+    if rows.is_empty() {
+        bail!("no validation row matches {only:?}");
+    }
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    eprintln!("plugsim validate: {} runs into {}", rows.len(), out.display());
+    let mut outcomes = Vec::new();
+    for (k, row) in rows.iter().enumerate() {
+        eprintln!("  [{}/{}] {} ...", k + 1, rows.len(), row.id);
+        outcomes.push(run_row(row, out, &mut |_| {}));
+    }
+    let (md, csv) = table(&outcomes);
+    let commit = env!("PLUGSIM_COMMIT");
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".into());
+    let report = format!(
+        "Produced by `plugsim validate` ({} {commit}) on {cpu}, {} threads.\n\n{md}",
+        env!("CARGO_PKG_VERSION"),
+        rayon::current_num_threads()
+    );
+    std::fs::write(out.join("validation.md"), &report)?;
+    std::fs::write(out.join("validation.csv"), &csv)?;
+    for e in EXPERIMENTS {
+        let plot = velocity_plot(&outcomes, e);
+        if !plot.series.is_empty() {
+            let path = out.join(format!("velocity_{}.png", e.name));
+            plugsim::io::save_line_plot(&path, &plot)?;
+            println!("plot: {}", path.display());
+        }
+    }
+    println!("{report}");
+    println!("written: {0}/validation.md, {0}/validation.csv", out.display());
     Ok(())
 }
 
