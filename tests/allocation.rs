@@ -4,6 +4,8 @@
 //! heat conduction) after a short warm-up in which scratch reaches its size.
 
 use plugsim::case::Case;
+
+mod common;
 use plugsim::run::build_simulation;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -30,22 +32,7 @@ static GLOBAL: Counting = Counting;
 
 #[test]
 fn steps_without_cracks_do_not_allocate() {
-    let text = include_str!("../cases/borvik-1-nofracture.toml");
-    let set: Vec<String> = [
-        "bodies.plate.rectangle.x_min=-0.03",
-        "bodies.plate.rectangle.x_max=0.03",
-        "bodies.plate.rectangle.layers=10",
-        "bodies.plate.rectangle.fine_half_width=0.015",
-        "bodies.plate.supports.0.region.x_min=-0.03",
-        "bodies.plate.supports.0.region.x_max=-0.028",
-        "bodies.plate.supports.1.region.x_min=0.028",
-        "bodies.plate.supports.1.region.x_max=0.03",
-        "heat.every=1",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
-    let case = Case::from_str_with(text, "borvik", &set).unwrap().resolved();
+    let case = common::small_borvik_nofracture(&["heat.every=1"]);
     // Step inside the pool, as a worker: calls from outside would go
     // through rayon's job injector, whose queue allocates a block now and
     // then (rayon's, not ours).

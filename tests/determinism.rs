@@ -1,27 +1,13 @@
 //! Results are bit-identical for any thread count (the force assembly is a
 //! gather in fixed order; global sums run in index order).
 
-use plugsim::case::Case;
+mod common;
 use plugsim::run::build_simulation;
 use plugsim::step::Simulation;
 
 fn run_on(threads: usize, steps: usize) -> Simulation {
-    let text = include_str!("../cases/borvik-1-nofracture.toml");
     // a narrower, coarser plate keeps the test short; physics as the real case
-    let set: Vec<String> = [
-        "bodies.plate.rectangle.x_min=-0.03",
-        "bodies.plate.rectangle.x_max=0.03",
-        "bodies.plate.rectangle.layers=10",
-        "bodies.plate.rectangle.fine_half_width=0.015",
-        "bodies.plate.supports.0.region.x_min=-0.03",
-        "bodies.plate.supports.0.region.x_max=-0.028",
-        "bodies.plate.supports.1.region.x_min=0.028",
-        "bodies.plate.supports.1.region.x_max=0.03",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
-    let case = Case::from_str_with(text, "borvik", &set).unwrap().resolved();
+    let case = common::small_borvik_nofracture(&[]);
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     pool.install(|| {
         let mut sim = build_simulation(&case).unwrap();
