@@ -189,7 +189,7 @@ impl Simulation {
     /// against the rigid bodies of `contact`.
     pub fn with_contact(model: Model, rule: TimeStepRule, contact: ContactSystem) -> Self {
         let mut sim = Simulation::new(model, rule);
-        let rigid: Real = contact.bodies.iter().map(|b| 0.5 * b.mass * b.velocity.norm_squared()).sum();
+        let rigid = rigid_kinetic_energy(&contact);
         sim.energies.rigid_kinetic = rigid;
         sim.energies.initial_kinetic += rigid;
         let vmax = contact.bodies.iter().map(|b| b.velocity.norm()).fold(0.0, Real::max);
@@ -342,7 +342,7 @@ impl Simulation {
         }
         self.energies.contact_work = wp;
         self.energies.rigid_work = wb;
-        self.energies.rigid_kinetic = contact.bodies.iter().map(|b| 0.5 * b.mass * b.velocity.norm_squared()).sum();
+        self.energies.rigid_kinetic = rigid_kinetic_energy(contact);
         Ok(())
     }
 
@@ -591,6 +591,11 @@ impl Simulation {
         }
         Ok(())
     }
+}
+
+/// `½ Σ M |V|²` of the rigid bodies.
+fn rigid_kinetic_energy(contact: &ContactSystem) -> Real {
+    contact.bodies.iter().map(|b| 0.5 * b.mass * b.velocity.norm_squared()).sum()
 }
 
 /// `½ Σ m |v|²`, summed in index order.
