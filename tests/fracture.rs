@@ -265,6 +265,41 @@ fn arrest_at_the_far_surface_in(mode: GeometryMode) {
     assert!(m.particles.mass.iter().all(|&x| x > 0.0), "positive masses");
 }
 
+/// One crack per failed zone: a wide zone at the top surface (many slave
+/// particles meeting the criterion, far beyond the distance exclusion of
+/// each other) nucleates one crack; a second zone, not connected to the
+/// first through failed material, nucleates its own.
+#[test]
+fn one_crack_nucleates_per_failed_zone() {
+    let (nx, ny) = (41, 9);
+    let top = (ny - 1) as Real * H;
+    let run = |zones: &[(Real, Real)]| {
+        let mut m = plate(nx, ny);
+        // failed (0.6) inside each [x0, x1] in the top three rows, 0.1 elsewhere
+        set_field(&mut m, |x| {
+            let inside = zones.iter().any(|&(a, b)| x.x >= a * H && x.x <= b * H) && x.y > top - 2.6 * H;
+            if inside {
+                0.6
+            } else {
+                0.1
+            }
+        });
+        let mut g = CrackGrowth::new(FractureParameters {
+            nucleation_distance_factor: 1.0,
+            ..params(Criterion::EffectiveStrain)
+        });
+        drive(&mut m, &mut g, 3);
+        g.cracks.iter().map(|c| c.vertices[0].x0.x / H).collect::<Vec<_>>()
+    };
+    // one zone 14 spacings wide: one crack (the distance rule alone would allow several)
+    let one = run(&[(3.0, 17.0)]);
+    assert_eq!(one.len(), 1, "one crack in one zone: {one:?}");
+    // two zones with unfailed material between them: one crack each
+    let two = run(&[(3.0, 12.0), (26.0, 36.0)]);
+    assert_eq!(two.len(), 2, "one crack per zone: {two:?}");
+    assert!(two.iter().any(|&x| x < 13.0) && two.iter().any(|&x| x > 25.0), "{two:?}");
+}
+
 #[test]
 fn shape_function_ahead_of_the_tip_is_cut_in_two() {
     let (nx, ny) = (21, 11);

@@ -184,6 +184,30 @@ pub struct CrackGrowth {
     pub reduced_particle_rows: BTreeMap<usize, Basis>,
 }
 
+/// Scratch of the failed-zone search of one nucleation stage.
+struct FailedZones {
+    /// Criterion values computed so far.
+    value: Vec<Option<Real>>,
+    /// Particles of zones found to hold a crack.
+    cracked: Vec<bool>,
+    /// Search stamp per particle.
+    seen: Vec<u32>,
+    stamp: u32,
+}
+
+impl FailedZones {
+    fn new(n: usize) -> Self {
+        FailedZones { value: vec![None; n], cracked: vec![false; n], seen: vec![0; n], stamp: 0 }
+    }
+
+    /// Room for particles appended by splits.
+    fn grow(&mut self, n: usize) {
+        self.value.resize(n, None);
+        self.cracked.resize(n, false);
+        self.seen.resize(n, 0);
+    }
+}
+
 /// A split to perform at a crack vertex.
 struct Split {
     parent: usize,
@@ -450,6 +474,7 @@ impl CrackGrowth {
         }
         cores.sort_by(|a, b| b.0.partial_cmp(&a.0).expect("finite").then(a.1.cmp(&b.1)));
         let mut faces = Vec::new();
+        let mut zones = FailedZones::new(model.particles.len());
         for (_, i) in cores {
             // the core may have been re-indexed by nothing (splits append), but
             // a split in this loop may have put it on a face
@@ -466,6 +491,9 @@ impl CrackGrowth {
                 continue;
             }
             self.ensure_grid(model);
+            if self.failed_zone_holds_a_crack(model, i, critical, &mut zones) {
+                continue;
+            }
             let mut best: Option<(Real, usize)> = None;
             for j in self.circle(model, i) {
                 let f = model.particles.flags[j];
@@ -491,6 +519,55 @@ impl CrackGrowth {
             }
         }
         Ok(faces)
+    }
+
+    /// Whether the failed zone of particle `i` — the particles meeting the
+    /// criterion connected to `i` through circles of radius `R` with
+    /// unblocked sight lines — already holds a crack (a crack-face particle
+    /// or a growing tip). One crack per failed zone (module doc).
+    /// `zones` remembers the particles seen in this stage: a zone found
+    /// cracked stays cracked, and an uncracked one is searched again (a
+    /// split in this stage may have put a crack into it).
+    fn failed_zone_holds_a_crack(&self, model: &Model, i: usize, critical: Real, zones: &mut FailedZones) -> bool {
+        zones.grow(model.particles.len());
+        if zones.cracked[i] {
+            return true;
+        }
+        let tips: Vec<usize> = self.cracks.iter().filter_map(|c| c.tip).collect();
+        let is_crack = |j: usize| model.particles.flags[j].has(ParticleFlags::CRACK_FACE) || tips.contains(&j);
+        zones.stamp += 1;
+        let stamp = zones.stamp;
+        zones.seen[i] = stamp;
+        let mut stack = vec![i];
+        let mut visited = vec![i];
+        let mut found = false;
+        while let Some(k) = stack.pop() {
+            let xk = model.particles.x0[k];
+            for j in self.circle(model, k) {
+                if zones.seen[j] == stamp || self.segments.blocked(&xk, &model.particles.x0[j]) {
+                    continue;
+                }
+                if is_crack(j) || zones.cracked[j] {
+                    found = true;
+                    break;
+                }
+                let value = *zones.value[j].get_or_insert_with(|| self.criterion_value(model, j));
+                if value >= critical {
+                    zones.seen[j] = stamp;
+                    stack.push(j);
+                    visited.push(j);
+                }
+            }
+            if found {
+                break;
+            }
+        }
+        if found {
+            for k in visited {
+                zones.cracked[k] = true;
+            }
+        }
+        found
     }
 
     /// Nucleation: split core `i` in halves normal to `X_i X_j`; `j` is the tip.

@@ -34,10 +34,20 @@
 //!   in decreasing order of value, each becomes a core unless it lies on a
 //!   crack face or within `nucleation_distance_factor × h` of an existing
 //!   crack path (one crack per stress concentration; the neighbours of a
-//!   core meet the criterion a few steps later), or on the axis in
+//!   core meet the criterion a few steps later), or in a **failed zone that
+//!   already holds a crack** — the particles meeting the criterion that
+//!   are connected to the core through circles of radius `R` with
+//!   unblocked sight lines reach a crack-face particle or a growing tip
+//!   (`one_crack_nucleates_per_failed_zone`) — or on the axis in
 //!   axisymmetry (flagged surface and slave as an edge of the r-z section,
 //!   but no surface of the body; `no_crack_nucleates_on_the_axis`,
-//!   `axisymmetric_crack_starts_at_the_corner_not_on_the_axis`). The initial direction is
+//!   `axisymmetric_crack_starts_at_the_corner_not_on_the_axis`). The
+//!   failed-zone rule is what keeps the number of cracks independent of the
+//!   resolution: the distance rule counts spacings, and in the fine Borvik
+//!   plane-strain model (48 rows) the failed zone under each projectile
+//!   corner is ~2.5 mm = 11 spacings wide at 4.6 µs, so a second crack
+//!   started 2.4 mm inside the corner, ran diagonally into the first and cut
+//!   out a sliver that went unstable at 8.2 µs. The initial direction is
 //!   set by the tip: the particle within `R` of the core that meets the
 //!   criterion with the largest value, not on a surface (a first segment
 //!   along the free surface would cut nothing), not on a crack face. No
