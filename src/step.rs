@@ -392,6 +392,9 @@ impl Simulation {
     /// Deformation and velocity gradients, material update, `P w`.
     #[allow(non_snake_case)]
     fn update_material(&mut self, dt: Real) -> Result<(), SolverError> {
+        // While cracks grow, points fractured by their damage carry only
+        // compression (`material::fractured`).
+        let cracking = self.cracks.as_ref().is_some_and(|c| c.params.critical_value().is_some());
         let m = &mut self.model;
         let (tab, u, v, mode, mats) = (&m.qp_shape, &m.particles.u, &m.particles.v, m.mode, &m.materials);
         let q = &mut m.quad;
@@ -446,6 +449,7 @@ impl Simulation {
                     damage: *dmg,
                 };
                 let new = mats[*body as usize].update(&old, &kin);
+                let new = if cracking { crate::material::fractured(new) } else { new };
                 *work = 0.5 * ddot(&(old.tau + new.tau), &kin.d) * dt * w;
                 *f = F_new;
                 *tau = new.tau;

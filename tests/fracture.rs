@@ -300,6 +300,29 @@ fn one_crack_nucleates_per_failed_zone() {
     assert!(two.iter().any(|&x| x < 13.0) && two.iter().any(|&x| x > 25.0), "{two:?}");
 }
 
+/// The triaxiality cut-off: a failed zone under hydrostatic compression
+/// (σ_m/σ_eq = −1) nucleates nothing; the same zone in shear (0) does.
+#[test]
+fn no_crack_nucleates_in_compression() {
+    let (nx, ny) = (21, 9);
+    let top = (ny - 1) as Real * H;
+    let run = |mean: Real| {
+        let mut m = plate(nx, ny);
+        set_field(&mut m, |x| if (x.x - 10.0 * H).abs() < 3.1 * H && x.y > top - 2.6 * H { 0.6 } else { 0.1 });
+        let shear = nalgebra::Matrix3::new(0.0, 1e8, 0.0, 1e8, 0.0, 0.0, 0.0, 0.0, 0.0);
+        for q in 0..m.quad.len() {
+            // von Mises of the shear part: sqrt(3) 1e8
+            m.quad.tau[q] = shear + nalgebra::Matrix3::identity() * (mean * 3f64.sqrt() * 1e8);
+        }
+        let mut g = CrackGrowth::new(params(Criterion::EffectiveStrain));
+        drive(&mut m, &mut g, 2);
+        g.cracks.len()
+    };
+    assert_eq!(run(-1.0), 0, "compression: no crack");
+    assert_eq!(run(-0.3), 1, "just above the cut-off: a crack");
+    assert_eq!(run(0.0), 1, "shear: a crack");
+}
+
 #[test]
 fn shape_function_ahead_of_the_tip_is_cut_in_two() {
     let (nx, ny) = (21, 11);

@@ -6,7 +6,7 @@
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use plugsim::material::johnson_cook::{JohnsonCook, RateForm};
 use plugsim::material::library::{weldox_460e, weldox_460e_borvik};
-use plugsim::material::{Constitutive, Elastic, Material, PointState, StepKinematics};
+use plugsim::material::{fractured, Constitutive, Elastic, Material, PointState, StepKinematics};
 use plugsim::material_point::{run, DriverConfig, LoadPath, Record};
 
 type M3 = Matrix3<f64>;
@@ -500,4 +500,31 @@ fn virgin_point_yields_under_every_path_and_law() {
             assert!(last.equivalent_stress < 1.5 * m.yield_stress, "{:?} {path:?}", m.rate_form);
         }
     }
+}
+
+/// A point whose Johnson–Cook damage reaches 1 keeps only compressive
+/// pressure (`plugsim::material::fractured`); below 1 nothing changes.
+#[test]
+fn fractured_points_carry_only_compression() {
+    let jc = weldox_460e();
+    // shear plus volumetric stretch: tension and shear
+    let d = M3::new(1e5, 2e5, 0.0, 2e5, 1e5, 0.0, 0.0, 0.0, 0.0);
+    let k = StepKinematics { d, w: M3::zeros(), dt: 1e-8 };
+    let tau0 = M3::new(3e8, 4e8, 0.0, 4e8, 3e8, 0.0, 0.0, 0.0, 1e8);
+    let below = PointState { tau: tau0, eps_p: 0.5, eps_p_rate: 1e4, temperature: 400.0, damage: 0.2 };
+    let own = jc.update(&below, &k);
+    assert_eq!(fractured(own), own, "intact points keep the model's update");
+    let failed = PointState { damage: 1.0, ..below };
+    let own = jc.update(&failed, &k);
+    let s = fractured(own);
+    assert!(own.tau.trace() > 0.0 && (own.tau - M3::identity() * own.tau.trace() / 3.0).norm() > 1e8);
+    assert_eq!(s.tau, M3::zeros(), "no tension, no shear: {}", s.tau);
+    assert_eq!((s.eps_p, s.temperature, s.damage), (own.eps_p, own.temperature, own.damage));
+    // compression stays, as pressure only
+    let k_c = StepKinematics { d: M3::identity() * -1e5, w: M3::zeros(), dt: 1e-8 };
+    let pressed = PointState { tau: M3::identity() * -5e8 + tau0 * 0.1, ..failed };
+    let own = jc.update(&pressed, &k_c);
+    let s = fractured(own);
+    assert!((s.tau - M3::identity() * (own.tau.trace() / 3.0)).norm() < 1e-9 * own.tau.norm());
+    assert!(s.tau.trace() < -1.0e9);
 }

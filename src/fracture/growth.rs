@@ -25,6 +25,11 @@ pub const EXTENSION_PER_OFFSET: Real = 5.0;
 /// this angle with the surface normal, degrees (module doc).
 pub const MAX_SURFACE_OBLIQUITY: Real = 40.0;
 
+/// No crack nucleates where the stress triaxiality `σ_m / σ_eq` is below
+/// this value: Bao and Wierzbicki's cut-off (2005), below which ductile
+/// metals do not fracture (module doc of [`crate::fracture`]).
+pub const NUCLEATION_MIN_TRIAXIALITY: Real = -1.0 / 3.0;
+
 /// Smallest lumped mass of a re-lumped particle, as a fraction of its
 /// nodal mass `ρ ΔV_I` (times `2πR` in axisymmetry: [`nodal_mass`]; see the
 /// module doc of [`crate::fracture`]).
@@ -288,6 +293,24 @@ impl CrackGrowth {
         }
     }
 
+    /// Stress triaxiality `σ_m / σ_eq` at particle `i`: the ratio of the
+    /// lumped projections of the quadrature points' mean and von Mises
+    /// stresses (the same weights as [`Self::criterion_value`]).
+    pub fn triaxiality(&self, model: &Model, i: usize) -> Real {
+        let (mut m, mut e) = (0.0, 0.0);
+        for j in model.gather.range(i) {
+            let (k, q) = (model.gather.entry[j] as usize, model.gather.point[j] as usize);
+            let w = model.qp_shape.value[k] * model.quad.weight[q];
+            m += w * crate::math::mean_stress(&model.quad.tau[q]);
+            e += w * crate::math::von_mises(&model.quad.tau[q]);
+        }
+        if e > 0.0 {
+            m / e
+        } else {
+            0.0
+        }
+    }
+
     /// Time of plug separation: when the through-cracks that cut a plug
     /// out have all arrested — two in plane strain (one on each side of
     /// the projectile), one in axisymmetry (a ring crack).
@@ -467,7 +490,7 @@ impl CrackGrowth {
                 f.has(ParticleFlags::SLAVE) && !f.has(ParticleFlags::CRACK_FACE) && !f.has(ParticleFlags::ON_AXIS)
             })
             .map(|i| (self.criterion_value(model, i), i))
-            .filter(|&(v, _)| v >= critical)
+            .filter(|&(v, i)| v >= critical && self.triaxiality(model, i) >= NUCLEATION_MIN_TRIAXIALITY)
             .collect();
         if cores.is_empty() {
             return Ok(Vec::new());
