@@ -59,9 +59,13 @@
 //!   2005). The effective-strain criterion alone knows no stress state: in
 //!   the Borvik plane-strain Case I the whole top face of the plug, pressed
 //!   by the projectile (`σ_m/σ_eq ≈ −0.6`), reaches `ε̄ = 0.30` at ~40 µs and a
-//!   third crack started at its centre. At the projectile corners the cut-off
-//!   delays nucleation by 0.12 µs (1.32 → 1.44 µs) and leaves the arrest
-//!   times unchanged (`no_crack_nucleates_in_compression`).
+//!   third crack started at its centre. The projectile corners still
+//!   nucleate at 1.32 µs (`no_crack_nucleates_in_compression`). Known
+//!   limit: once the plug flies free (no contact after 23.5 µs in that
+//!   case), its stresses are small vibrations whose triaxiality is noise,
+//!   and a crack can still start on its top face (32.5 µs there) — after
+//!   the projectile's residual velocity is settled. The damage criterion,
+//!   whose damage grows slowly in compression, has no such crack.
 //! - Arrest is tested **before** propagation: a tip whose circle of radius
 //!   `R` holds an empty sector wider than `θ_c` around its direction of
 //!   growth is on the outer surface and stops, even if a surface neighbour
