@@ -321,6 +321,27 @@ fn no_crack_nucleates_in_compression() {
     assert_eq!(run(-1.0), 0, "compression: no crack");
     assert_eq!(run(-0.3), 1, "just above the cut-off: a crack");
     assert_eq!(run(0.0), 1, "shear: a crack");
+    // nor does a crack grow into compressed material: a crack down a failed
+    // column stops where the column is compressed
+    let grow = |mean: Real| {
+        let mut m = plate(nx, ny);
+        set_field(&mut m, |x| if (x.x - 10.0 * H).abs() < 0.6 * H { 0.6 } else { 0.1 });
+        let shear = nalgebra::Matrix3::new(0.0, 1e8, 0.0, 1e8, 0.0, 0.0, 0.0, 0.0, 0.0);
+        for q in 0..m.quad.len() {
+            let below = m.quad.x0[q].y < top - 3.5 * H;
+            let p = if below { mean } else { 0.0 };
+            m.quad.tau[q] = shear + nalgebra::Matrix3::identity() * (p * 3f64.sqrt() * 1e8);
+        }
+        let mut g = CrackGrowth::new(params(Criterion::EffectiveStrain));
+        let start = [id(&m, 10, ny - 1), id(&m, 10, ny - 2)];
+        g.insert_crack(&mut m, &start, false).unwrap();
+        drive(&mut m, &mut g, 12);
+        let tip = g.cracks[0].tip.map(|t| m.particles.x0[t].y / H);
+        (g.cracks[0].arrested.is_some(), tip)
+    };
+    assert_eq!(grow(0.0).0, true, "shear all the way: through the strip");
+    let (arrested, tip) = grow(-1.0);
+    assert!(!arrested && tip.is_some_and(|y| y > (ny - 1) as Real - 4.5), "stops above the compressed part: {tip:?}");
 }
 
 #[test]

@@ -25,8 +25,8 @@ pub const EXTENSION_PER_OFFSET: Real = 5.0;
 /// this angle with the surface normal, degrees (module doc).
 pub const MAX_SURFACE_OBLIQUITY: Real = 40.0;
 
-/// No crack nucleates where the stress triaxiality `σ_m / σ_eq` is below
-/// this value: Bao and Wierzbicki's cut-off (2005), below which ductile
+/// No crack nucleates or grows into material whose stress triaxiality
+/// `σ_m / σ_eq` is below this value: Bao and Wierzbicki's cut-off (2005), below which ductile
 /// metals do not fracture (module doc of [`crate::fracture`]).
 pub const NUCLEATION_MIN_TRIAXIALITY: Real = -1.0 / 3.0;
 
@@ -362,6 +362,9 @@ impl CrackGrowth {
                 if value < critical || best.is_some_and(|(bv, _)| bv >= value) {
                     continue;
                 }
+                if self.triaxiality(model, j) < NUCLEATION_MIN_TRIAXIALITY {
+                    continue;
+                }
                 if self.passes_over(model, tip, j) || self.blocked_from_tip(model, c, j) {
                     continue;
                 }
@@ -525,6 +528,9 @@ impl CrackGrowth {
                 }
                 let value = self.criterion_value(model, j);
                 if value < critical || best.is_some_and(|(bv, _)| bv >= value) {
+                    continue;
+                }
+                if self.triaxiality(model, j) < NUCLEATION_MIN_TRIAXIALITY {
                     continue;
                 }
                 if self.passes_over(model, i, j) || self.segments.blocked(&xi, &model.particles.x0[j]) {
