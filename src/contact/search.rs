@@ -15,8 +15,13 @@
 //!    *entry face*, the one whose line it crossed last on its straight path
 //!    from its start-of-step position `x⁰` (time of crossing
 //!    `t = g⁰/(g⁰ − g)` with `g⁰ = max(0, gap at x⁰)`); where that does not
-//!    decide (it was inside both already), the face it moves into fastest
-//!    (smaller `(x − x⁰)·n`), and last the larger gap.
+//!    decide (it was inside both already), the face it was shallower
+//!    behind at `x⁰` if the depths differ by more than twice the step's
+//!    displacement `|x − x⁰|` (a crack-face particle of the fine Borvik run
+//!    that slid just inside the projectile's side wall, 20 mm above the
+//!    nose, was paired with the nose and thrown 20 mm in one step), else
+//!    the face it moves into fastest (smaller `(x − x⁰)·n`), and last the
+//!    larger gap.
 //!
 //! The gap is `g = (x − x_m)·n_m` with `x_m` a point of the feature and
 //! `n_m` its outward normal; `g < 0` is penetration. It is evaluated as
@@ -58,6 +63,11 @@ use crate::math::{Real, Vec2};
 /// Differences of entry times (dimensionless) and of `d·n` (relative to
 /// `|d|`) below which they do not decide between two faces.
 const ENTRY_RESOLUTION: Real = 1e-9;
+
+/// Inside two faces' lines at the start of the step, the shallower face is
+/// chosen when the depths differ by more than this many step displacements
+/// (module doc).
+const DEPTH_FACTOR: Real = 2.0;
 
 /// The result of pairing a point with a master feature.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -145,6 +155,14 @@ fn entry_prefers_first(
         return ta > tb;
     }
     let d = x - from;
+    // Inside both lines already at the start: a face the point was much
+    // deeper behind than it can move in a step is not the one it is
+    // pressing on (a particle that slid inside a side wall, far from the
+    // nose, is not 20 mm into the nose): the shallower face at the start.
+    let (g0a, g0b) = (on_segment(body, at, ka, from).1, on_segment(body, at, kb, from).1);
+    if (g0a - g0b).abs() > DEPTH_FACTOR * d.norm() {
+        return g0a > g0b;
+    }
     let (da, db) = (d.dot(&body.segment_normal(ka)), d.dot(&body.segment_normal(kb)));
     if (da - db).abs() > ENTRY_RESOLUTION * d.norm() {
         return da < db;
@@ -252,6 +270,13 @@ mod tests {
         let p = check_pairing(&b, &o, MasterFeature::Segment(0), &y).unwrap();
         assert_eq!(p.feature, MasterFeature::Segment(0));
         assert!((p.gap + 0.5).abs() < 1e-12);
+        // inside just behind the side wall, far above the nose, moving up
+        // (away from the nose, deeper behind its line): the side
+        let y = Vec2::new(9.999, -20.0);
+        let from = Vec2::new(9.999, -20.01);
+        let p = search_rigid_polygon(&b, &o, &y, &from).unwrap();
+        assert_eq!(p.feature, MasterFeature::Segment(1));
+        assert!((p.gap + 0.001).abs() < 1e-9);
         // past the end of the segment the pairing is dropped
         assert!(check_pairing(&b, &o, MasterFeature::Segment(0), &Vec2::new(10.5, -39.5)).is_none());
         assert!(check_pairing(&b, &o, MasterFeature::Segment(9), &y).is_none());
