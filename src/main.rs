@@ -550,8 +550,23 @@ fn drive(
     }
     if let Some(t) = s.separation {
         println!("  plug separated at {:.3} us (its cracks arrested through the thickness)", t * 1e6);
-    } else if !s.cracks.is_empty() {
-        println!("  plug not separated");
+    }
+    if let Some(t) = s.perforation {
+        println!("  plate perforated at {:.3} us (plug first cut out)", t * 1e6);
+    }
+    match &s.plug {
+        Some(p) => {
+            let v = p.velocity();
+            println!(
+                "  plug at the end: {} particles, mass {:.4e} kg (per metre of depth in plane strain), velocity ({:.2}, {:.2}) m/s",
+                p.particles.len(),
+                p.mass,
+                v.x,
+                v.y
+            );
+        }
+        None if !s.cracks.is_empty() => println!("  no plug cut out"),
+        None => {}
     }
     println!("  output: {} snapshots in {}/results.pvd, history in history.csv", s.snapshots, s.out_dir.display());
     for p in &s.plots {

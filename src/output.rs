@@ -13,8 +13,11 @@ use crate::model::Model;
 use crate::step::Simulation;
 use std::path::{Path, PathBuf};
 
-/// Columns of the history CSV that every run has, in order; each rigid
-/// body `NAME` adds `NAME_x, NAME_y` (m), `NAME_vx, NAME_vy` (m/s),
+/// Columns of the history CSV that every run has, in order: time, step,
+/// energies, and the plug once cracks have cut one out under the first
+/// rigid body (`plug_mass`, kg or kg/m in plane strain, and its
+/// mass-averaged velocity `plug_vx, plug_vy`, m/s; all 0 before, see
+/// [`crate::plug`]). Each rigid body `NAME` adds `NAME_x, NAME_y` (m), `NAME_vx, NAME_vy` (m/s),
 /// `NAME_fx, NAME_fy` (contact force on the body, N) and `NAME_contacts`.
 pub const HISTORY_COLUMNS: &[&str] = &[
     "time",
@@ -27,6 +30,9 @@ pub const HISTORY_COLUMNS: &[&str] = &[
     "contact_dissipation",
     "total_energy",
     "energy_drift",
+    "plug_mass",
+    "plug_vx",
+    "plug_vy",
 ];
 
 /// Columns of `cracks.csv`: one row per crack event; `particles` lists the
@@ -61,6 +67,8 @@ pub struct OutputWriter {
     crack_log: Option<std::io::BufWriter<std::fs::File>>,
     /// Crack events written so far.
     crack_events_written: usize,
+    /// The plug, followed from row to row.
+    plug: crate::plug::PlugTracker,
 }
 
 impl OutputWriter {
@@ -76,6 +84,7 @@ impl OutputWriter {
             snapshots: 0,
             crack_log: None,
             crack_events_written: 0,
+            plug: Default::default(),
         })
     }
 
@@ -130,6 +139,7 @@ impl OutputWriter {
             snapshots: n,
             crack_log: None,
             crack_events_written: 0,
+            plug: Default::default(),
         };
         let log = dir.join("cracks.csv");
         match cracks {
@@ -193,6 +203,14 @@ impl OutputWriter {
             e.total(),
             e.drift(),
         ];
+        let plug = match (&sim.cracks, impact_line(sim)) {
+            (Some(cracks), Some(axis_x)) => self.plug.update(&sim.model, cracks, axis_x),
+            _ => None,
+        };
+        match plug {
+            Some(p) => row.extend([p.mass, p.velocity().x, p.velocity().y]),
+            None => row.extend([0.0; 3]),
+        }
         if let Some(c) = &sim.contact {
             for b in 0..c.bodies.len() {
                 let s = c.sample(b).expect("body exists");
@@ -265,6 +283,12 @@ pub fn crack_piece(model: &Model, cracks: &crate::fracture::CrackGrowth) -> VtuP
     VtuPiece::poly_lines(points, lines)
         .with_cell_data(DataArray::integers("crack", ids))
         .with_cell_data(DataArray::integers("face", faces))
+}
+
+/// The impact line `x = x_c` of the first rigid body (the x-centre of its
+/// outline), under which [`crate::plug`] looks for the plug.
+pub fn impact_line(sim: &Simulation) -> Option<Real> {
+    projectile_extent(sim).map(|(lo, hi)| 0.5 * (lo + hi))
 }
 
 /// File name of snapshot `k`.
@@ -408,17 +432,38 @@ pub fn field_plot(sim: &Simulation, field: &str, window: Option<[Real; 4]>) -> O
     })
 }
 
+/// Extent `(x_min, x_max)` of the first rigid body's outline now, m.
+fn projectile_extent(sim: &Simulation) -> Option<(Real, Real)> {
+    let b = sim.contact.as_ref()?.bodies.first()?;
+    let (lo, hi) =
+        b.outline().iter().fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), v| (lo.min(v.x), hi.max(v.x)));
+    Some((b.position.x + lo, b.position.x + hi))
+}
+
+/// The view around the first rigid body: ±1.5 projectile widths about its
+/// centre line, the whole thickness.
+fn impact_window(sim: &Simulation) -> Option<[Real; 4]> {
+    projectile_extent(sim).map(|(lo, hi)| {
+        let (w, cx) = (hi - lo, 0.5 * (lo + hi));
+        [cx - 1.5 * w, cx + 1.5 * w, Real::NEG_INFINITY, Real::INFINITY]
+    })
+}
+
+/// The view of the shear band at the projectile's right-hand corner: a
+/// quarter of the projectile's width on either side of its edge, the whole
+/// thickness (in axisymmetry the right-hand edge is the rim, r = radius).
+fn shear_band_window(sim: &Simulation) -> Option<[Real; 4]> {
+    projectile_extent(sim).map(|(lo, hi)| {
+        let q = 0.25 * (hi - lo);
+        [hi - q, hi + q, Real::NEG_INFINITY, Real::INFINITY]
+    })
+}
+
 /// End-of-run field plots (`effective_stress.png`, `temperature.png`) of the
-/// region around the first rigid body (±2 projectile widths), or of
+/// region around the first rigid body (±1.5 projectile widths), or of
 /// everything without one.
 pub fn plot_fields(sim: &Simulation, dir: &Path) -> Result<Vec<PathBuf>, crate::run::RunError> {
-    let window = sim.contact.as_ref().and_then(|c| c.bodies.first()).map(|b| {
-        let (lo, hi) =
-            b.outline().iter().fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), v| (lo.min(v.x), hi.max(v.x)));
-        let w = hi - lo;
-        let cx = b.position.x + 0.5 * (lo + hi);
-        [cx - 1.5 * w, cx + 1.5 * w, Real::NEG_INFINITY, Real::INFINITY]
-    });
+    let window = impact_window(sim);
     let mut written = Vec::new();
     for field in ["effective_stress", "temperature"] {
         if let Some(plot) = field_plot(sim, field, window) {
@@ -428,6 +473,58 @@ pub fn plot_fields(sim: &Simulation, dir: &Path) -> Result<Vec<PathBuf>, crate::
         }
     }
     Ok(written)
+}
+
+/// Label of a plot time in file names: `28us`, `28.5us` (to 0.1 µs).
+pub fn time_label(t: Real) -> String {
+    let tenths = (t * 1e7).round();
+    if tenths % 10.0 == 0.0 {
+        format!("{:.0}us", tenths / 10.0)
+    } else {
+        format!("{:.1}us", tenths / 10.0)
+    }
+}
+
+/// The field plots asked for at time `at` (`output.plot_times`), drawn from
+/// the current state (the first at or after `at`): the deformed bodies
+/// around the first rigid body coloured by effective stress, with the
+/// cracks (`effective_stress_<at>.png`), and the temperature of the shear
+/// band at the projectile's corner (`temperature_<at>.png`, see
+/// [`time_label`]); both fields over everything without a rigid body.
+pub fn plot_fields_at(sim: &Simulation, dir: &Path, at: Real) -> Result<Vec<PathBuf>, crate::run::RunError> {
+    let label = time_label(at);
+    let mut written = Vec::new();
+    for (field, window) in [("effective_stress", impact_window(sim)), ("temperature", shear_band_window(sim))] {
+        if let Some(plot) = field_plot(sim, field, window) {
+            let path = dir.join(format!("{field}_{label}.png"));
+            crate::io::save_field_plot(&path, &plot)?;
+            written.push(path);
+        }
+    }
+    Ok(written)
+}
+
+/// The perforation time of the run in `dir`: when the plug was first cut
+/// out (the first `history.csv` row with a plug, `plug_mass > 0`), refined
+/// to the time of the last crack event (`event_times`) after the row before
+/// it and not after it — the event that severed the plate (the crack set
+/// changes only at events). `None` if no row has a plug.
+pub fn perforation_time(dir: &Path, event_times: &[Real]) -> Result<Option<Real>, IoError> {
+    let table = crate::io::HistoryTable::read(&dir.join("history.csv"))?;
+    let (Some(time), Some(mass)) = (table.column("time"), table.column("plug_mass")) else {
+        return Ok(None);
+    };
+    let Some(k) = mass.iter().position(|&m| m > 0.0) else {
+        return Ok(None);
+    };
+    let (row, before) = (time[k], if k > 0 { time[k - 1] } else { Real::NEG_INFINITY });
+    let slack = 1e-9 * row.abs().max(Real::MIN_POSITIVE);
+    let event = event_times
+        .iter()
+        .cloned()
+        .filter(|&t| t > before && t <= row + slack)
+        .fold(None, |m: Option<Real>, t| Some(m.map_or(t, |m| m.max(t))));
+    Ok(Some(event.unwrap_or(row)))
 }
 
 /// When each rigid body was last in contact, from the run's `history.csv`
@@ -466,5 +563,32 @@ mod tests {
         let got = last_contact_times(&dir, &["p".into(), "q".into()]).unwrap();
         assert_eq!(got, vec![("p".to_string(), Some(3.0)), ("q".to_string(), None)]);
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn perforation_is_the_event_that_first_left_a_plug() {
+        let dir = std::env::temp_dir().join(format!("plugsim-perforation-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut h = HistoryWriter::create(&dir.join("history.csv"), &["time", "plug_mass"]).unwrap();
+        for (t, m) in [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (3.0, 0.5), (4.0, 0.5)] {
+            h.write_row(&[t, m]).unwrap();
+        }
+        drop(h);
+        // events at 1.5 (a crack grows) and 2.4, 2.6 (the second crack arrests at 2.6)
+        assert_eq!(perforation_time(&dir, &[1.5, 2.4, 2.6, 3.5]).unwrap(), Some(2.6));
+        // no event between the rows: the row's time
+        assert_eq!(perforation_time(&dir, &[1.5]).unwrap(), Some(3.0));
+        let mut h = HistoryWriter::create(&dir.join("history.csv"), &["time", "plug_mass"]).unwrap();
+        h.write_row(&[0.0, 0.0]).unwrap();
+        drop(h);
+        assert_eq!(perforation_time(&dir, &[]).unwrap(), None);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn plot_time_labels() {
+        assert_eq!(time_label(28e-6), "28us");
+        assert_eq!(time_label(46.0e-6 + 1e-12), "46us");
+        assert_eq!(time_label(28.5e-6), "28.5us");
     }
 }
