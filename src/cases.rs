@@ -1,11 +1,11 @@
 //! Built-in cases, selectable by name from the CLI (`plugsim run --case NAME`).
 //! Each is the text of a file under `cases/`, so what runs is what users read.
 //!
-//! Børvik's reference cases ([RL10] §5, SPEC §10) form one family named
+//! Børvik's reference cases (\[RL10\] §5, SPEC §10) form one family named
 //! `borvik-<1|2>-<plane-strain|axisymmetric>[-fine][-damage][-modified]`:
 //! Case I or II; the paper's plane-strain model or the true axisymmetric
 //! geometry; the coarse (24 rows) or fine (48 rows) discretization; the
-//! effective-strain (default) or damage crack criterion; [RL10]'s material
+//! effective-strain (default) or damage crack criterion; \[RL10\]'s material
 //! (default) or Børvik's modified one (axisymmetric fine only). All share one
 //! set of numerical parameters ([`borvik_family`] lists them; the
 //! `tests/reference_cases.rs` suite checks the family is complete and
@@ -133,7 +133,7 @@ pub const BUILTIN_CASES: &[(&str, &str, &str)] = &[
 /// Short names for the paper's models: `(alias, built-in case)`.
 pub const ALIASES: &[(&str, &str)] = &[("borvik-1", "borvik-1-plane-strain"), ("borvik-2", "borvik-2-plane-strain")];
 
-/// The built-in material of [RL10] (Table 2).
+/// The built-in material of \[RL10\] (Table 2).
 pub const MATERIAL_RL10: &str = "weldox_460e";
 /// Børvik et al.'s modified fit of the same steel (power rate law).
 pub const MATERIAL_MODIFIED: &str = "weldox_460e_borvik";
@@ -171,7 +171,7 @@ impl BorvikCase {
         n
     }
 
-    /// Whether this is one of [RL10]'s own models (plane strain, its material).
+    /// Whether this is one of \[RL10\]'s own models (plane strain, its material).
     pub fn is_papers_model(&self) -> bool {
         self.geometry == "plane_strain" && self.material == MATERIAL_RL10
     }
@@ -179,7 +179,7 @@ impl BorvikCase {
 
 /// The whole reference family, in the order `plugsim validate` reports it:
 /// per case, both geometries × both discretizations × both criteria with
-/// [RL10]'s material, then the axisymmetric fine cases with Børvik's
+/// \[RL10\]'s material, then the axisymmetric fine cases with Børvik's
 /// modified material (both criteria): 20 cases.
 pub fn borvik_family() -> Vec<BorvikCase> {
     let mut v = Vec::new();

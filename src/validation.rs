@@ -1,6 +1,6 @@
 //! `plugsim validate`: run Børvik's plugging cases (the built-in `borvik-*`
 //! family, [`crate::cases::borvik_family`]) and compare the projectile's
-//! residual velocity with the experiments and with [RL10]'s simulations
+//! residual velocity with the experiments and with \[RL10\]'s simulations
 //! (shared/reference/ren-li-2010.toml, Tables 1 and 3).
 //!
 //! What each row measures, as experimenters do:
@@ -34,7 +34,7 @@ use std::path::{Path, PathBuf};
 /// paused between two rows is not taken for the end of contact.
 pub const FREE_FLIGHT: Real = 1.0e-6;
 
-/// One of Børvik's experiments as printed in [RL10] (reference file).
+/// One of Børvik's experiments as printed in \[RL10\] (reference file).
 #[derive(Clone, Debug)]
 pub struct Experiment {
     pub name: &'static str,
@@ -44,15 +44,15 @@ pub struct Experiment {
     pub impact_velocity: Real,
     /// Measured residual velocity, m/s.
     pub residual: Real,
-    /// Time simulated by [RL10], s.
+    /// Time simulated by \[RL10\], s.
     pub simulated_time: Real,
-    /// Perforation time in [RL10]'s simulation (a crack through the plate), s.
+    /// Perforation time in \[RL10\]'s simulation (a crack through the plate), s.
     pub perforation_time: Real,
-    /// [RL10]'s simulated residuals: (particles, criterion, m/s).
+    /// \[RL10\]'s simulated residuals: (particles, criterion, m/s).
     pub paper: &'static [(usize, &'static str, Real)],
 }
 
-/// Tables 1 and 3 of [RL10] (`shared/reference/ren-li-2010.toml`).
+/// Tables 1 and 3 of \[RL10\] (`shared/reference/ren-li-2010.toml`).
 pub const EXPERIMENTS: &[Experiment] = &[
     Experiment {
         name: "case-1",
@@ -148,7 +148,7 @@ impl Outcome {
         }
     }
 
-    /// [RL10]'s value for this row: its own model (plane strain, its
+    /// \[RL10\]'s value for this row: its own model (plane strain, its
     /// material) only; coarse = 11,496 particles, fine = 45,984.
     pub fn paper(&self) -> Option<Real> {
         if !self.row.case.is_papers_model() {
@@ -314,7 +314,7 @@ pub fn velocity_plot(outcomes: &[Outcome], experiment: &Experiment) -> LinePlot 
     }
 }
 
-/// The field plots each row's run drew at [RL10]'s perforation time
+/// The field plots each row's run drew at \[RL10\]'s perforation time
 /// (`output.plot_times` of the case): `(row id, file)` relative to the
 /// validation directory, for the rows whose files exist.
 pub fn field_plots(outcomes: &[Outcome]) -> Vec<(String, String)> {
@@ -336,7 +336,7 @@ pub fn field_plots(outcomes: &[Outcome]) -> Vec<(String, String)> {
 /// the validation directory).
 pub fn report(header: &str, outcomes: &[Outcome], velocity_plots: &[String]) -> String {
     let (md, _) = table(outcomes);
-    let mut s = format!("{header}\n\n{md}\n{}\n", METHODS);
+    let mut s = format!("{header}\n\n{md}\n{METHODS}\n\n");
     for p in velocity_plots {
         s.push_str(&format!("![projectile speed]({p})\n"));
     }
