@@ -17,7 +17,8 @@ use std::path::{Path, PathBuf};
 /// energies, and the plug once cracks have cut one out under the first
 /// rigid body (`plug_mass`, kg or kg/m in plane strain, and its
 /// mass-averaged velocity `plug_vx, plug_vy`, m/s; all 0 before, see
-/// [`crate::plug`]). Each rigid body `NAME` adds `NAME_x, NAME_y` (m), `NAME_vx, NAME_vy` (m/s),
+/// [`crate::plug`]) with `perforation_time`, the time of the step after
+/// which it was first found (s; 0 before). Each rigid body `NAME` adds `NAME_x, NAME_y` (m), `NAME_vx, NAME_vy` (m/s),
 /// `NAME_fx, NAME_fy` (contact force on the body, N) and `NAME_contacts`.
 pub const HISTORY_COLUMNS: &[&str] = &[
     "time",
@@ -33,6 +34,7 @@ pub const HISTORY_COLUMNS: &[&str] = &[
     "plug_mass",
     "plug_vx",
     "plug_vy",
+    "perforation_time",
 ];
 
 /// Columns of `cracks.csv`: one row per crack event; `particles` lists the
@@ -67,8 +69,10 @@ pub struct OutputWriter {
     crack_log: Option<std::io::BufWriter<std::fs::File>>,
     /// Crack events written so far.
     crack_events_written: usize,
-    /// The plug, followed from row to row.
+    /// The plug, followed from step to step.
     plug: crate::plug::PlugTracker,
+    /// Step of the last history row (a step gets at most one).
+    last_row_step: Option<u64>,
 }
 
 impl OutputWriter {
@@ -85,6 +89,7 @@ impl OutputWriter {
             crack_log: None,
             crack_events_written: 0,
             plug: Default::default(),
+            last_row_step: None,
         })
     }
 
@@ -106,6 +111,11 @@ impl OutputWriter {
         let cols = history_columns(rigid_names);
         let cols: Vec<&str> = cols.iter().map(|s| s.as_str()).collect();
         let history = HistoryWriter::continue_at(&dir.join("history.csv"), &cols, history_bytes)?;
+        // The perforation time so far is in the rows kept (the last row's
+        // column: the row of the step that cut the plug out is always written).
+        let kept = crate::io::HistoryTable::read(&dir.join("history.csv"))?;
+        let first_cut = kept.column("perforation_time").and_then(|c| c.last().copied()).filter(|&t| t > 0.0);
+        let last_row_step = kept.column("step").and_then(|c| c.last().copied()).map(|s| s as u64);
         // In the order `snapshot` appends them: by time, then part.
         let entries = snapshot_times
             .iter()
@@ -139,7 +149,8 @@ impl OutputWriter {
             snapshots: n,
             crack_log: None,
             crack_events_written: 0,
-            plug: Default::default(),
+            plug: crate::plug::PlugTracker::continuing(first_cut),
+            last_row_step,
         };
         let log = dir.join("cracks.csv");
         match cracks {
@@ -188,8 +199,12 @@ impl OutputWriter {
         Ok(path)
     }
 
-    /// Append one history row.
+    /// Append one history row (none if this step has one already).
     pub fn history_row(&mut self, sim: &Simulation) -> Result<(), IoError> {
+        if self.last_row_step == Some(sim.step) {
+            return Ok(());
+        }
+        self.last_row_step = Some(sim.step);
         let e = &sim.energies;
         let mut row = vec![
             sim.time,
@@ -204,13 +219,14 @@ impl OutputWriter {
             e.drift(),
         ];
         let plug = match (&sim.cracks, impact_line(sim)) {
-            (Some(cracks), Some(axis_x)) => self.plug.update(&sim.model, cracks, axis_x),
+            (Some(cracks), Some(axis_x)) => self.plug.update(&sim.model, cracks, axis_x, sim.time),
             _ => None,
         };
         match plug {
             Some(p) => row.extend([p.mass, p.velocity().x, p.velocity().y]),
             None => row.extend([0.0; 3]),
         }
+        row.push(self.plug.first_cut.unwrap_or(0.0));
         if let Some(c) = &sim.contact {
             for b in 0..c.bodies.len() {
                 let s = c.sample(b).expect("body exists");
@@ -230,13 +246,25 @@ impl OutputWriter {
 }
 
 impl OutputWriter {
-    /// Append the crack events not yet written to `cracks.csv` (created at
-    /// the first event, with the header [`CRACK_COLUMNS`]).
+    /// After every step: append the crack events not yet written to
+    /// `cracks.csv` (created at the first event, with the header
+    /// [`CRACK_COLUMNS`]) and, if the cracks changed, look for the plug, so
+    /// that the perforation time is that of the step that cut it out; that
+    /// step gets a history row of its own (so a resumed run finds the
+    /// perforation time in the rows before its checkpoint).
     pub fn crack_events(&mut self, sim: &Simulation) -> Result<(), IoError> {
-        match &sim.cracks {
-            Some(cracks) => self.write_crack_events(cracks),
-            None => Ok(()),
+        let Some(cracks) = &sim.cracks else {
+            return Ok(());
+        };
+        self.write_crack_events(cracks)?;
+        if let Some(axis_x) = impact_line(sim) {
+            let before = self.plug.first_cut;
+            self.plug.refresh(&sim.model, cracks, axis_x, sim.time);
+            if before.is_none() && self.plug.first_cut.is_some() {
+                self.history_row(sim)?;
+            }
         }
+        Ok(())
     }
 
     /// Append the events of `cracks` not yet written to `cracks.csv`.
@@ -505,26 +533,12 @@ pub fn plot_fields_at(sim: &Simulation, dir: &Path, at: Real) -> Result<Vec<Path
 }
 
 /// The perforation time of the run in `dir`: when the plug was first cut
-/// out (the first `history.csv` row with a plug, `plug_mass > 0`), refined
-/// to the time of the last crack event (`event_times`) after the row before
-/// it and not after it — the event that severed the plate (the crack set
-/// changes only at events). `None` if no row has a plug.
-pub fn perforation_time(dir: &Path, event_times: &[Real]) -> Result<Option<Real>, IoError> {
+/// out (the `perforation_time` column of the last `history.csv` row; the
+/// plug is looked for after every step that changed the cracks). `None` if
+/// no plug was cut out.
+pub fn perforation_time(dir: &Path) -> Result<Option<Real>, IoError> {
     let table = crate::io::HistoryTable::read(&dir.join("history.csv"))?;
-    let (Some(time), Some(mass)) = (table.column("time"), table.column("plug_mass")) else {
-        return Ok(None);
-    };
-    let Some(k) = mass.iter().position(|&m| m > 0.0) else {
-        return Ok(None);
-    };
-    let (row, before) = (time[k], if k > 0 { time[k - 1] } else { Real::NEG_INFINITY });
-    let slack = 1e-9 * row.abs().max(Real::MIN_POSITIVE);
-    let event = event_times
-        .iter()
-        .cloned()
-        .filter(|&t| t > before && t <= row + slack)
-        .fold(None, |m: Option<Real>, t| Some(m.map_or(t, |m| m.max(t))));
-    Ok(Some(event.unwrap_or(row)))
+    Ok(table.column("perforation_time").and_then(|c| c.last().copied()).filter(|&t| t > 0.0))
 }
 
 /// When each rigid body was last in contact, from the run's `history.csv`
@@ -566,22 +580,19 @@ mod tests {
     }
 
     #[test]
-    fn perforation_is_the_event_that_first_left_a_plug() {
+    fn perforation_time_is_read_from_the_last_history_row() {
         let dir = std::env::temp_dir().join(format!("plugsim-perforation-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
-        let mut h = HistoryWriter::create(&dir.join("history.csv"), &["time", "plug_mass"]).unwrap();
-        for (t, m) in [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (3.0, 0.5), (4.0, 0.5)] {
-            h.write_row(&[t, m]).unwrap();
+        let mut h = HistoryWriter::create(&dir.join("history.csv"), &["time", "perforation_time"]).unwrap();
+        for (t, p) in [(0.0, 0.0), (1.0, 0.0), (2.0, 1.7), (3.0, 1.7)] {
+            h.write_row(&[t, p]).unwrap();
         }
         drop(h);
-        // events at 1.5 (a crack grows) and 2.4, 2.6 (the second crack arrests at 2.6)
-        assert_eq!(perforation_time(&dir, &[1.5, 2.4, 2.6, 3.5]).unwrap(), Some(2.6));
-        // no event between the rows: the row's time
-        assert_eq!(perforation_time(&dir, &[1.5]).unwrap(), Some(3.0));
-        let mut h = HistoryWriter::create(&dir.join("history.csv"), &["time", "plug_mass"]).unwrap();
+        assert_eq!(perforation_time(&dir).unwrap(), Some(1.7));
+        let mut h = HistoryWriter::create(&dir.join("history.csv"), &["time", "perforation_time"]).unwrap();
         h.write_row(&[0.0, 0.0]).unwrap();
         drop(h);
-        assert_eq!(perforation_time(&dir, &[]).unwrap(), None);
+        assert_eq!(perforation_time(&dir).unwrap(), None);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

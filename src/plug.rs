@@ -156,22 +156,41 @@ pub fn find_plug(model: &Model, cracks: &CrackGrowth, axis_x: Real) -> Option<Pl
 /// Follows the plug through a run at low cost: the flood fill runs again
 /// only when the crack set or the particle count has changed since the last
 /// call (cracks only grow, so between changes the plug keeps its
-/// particles); in between, only its mass and momentum are summed.
+/// particles); in between, only its mass and momentum are summed. Refreshed
+/// after every step, it also knows when the plug was first cut out (the
+/// perforation time).
 #[derive(Clone, Debug, Default)]
 pub struct PlugTracker {
     /// Crack events and particles at the last flood fill.
     seen: Option<(usize, usize)>,
     particles: Option<Vec<usize>>,
+    /// Time of the first state in which a plug was found, s.
+    pub first_cut: Option<Real>,
 }
 
 impl PlugTracker {
-    /// The plug in the current state, if any (see [`find_plug`]).
-    pub fn update(&mut self, model: &Model, cracks: &CrackGrowth, axis_x: Real) -> Option<Plug> {
+    /// A tracker that continues a run in which the plug was first cut out
+    /// at `first_cut` (a resumed run).
+    pub fn continuing(first_cut: Option<Real>) -> Self {
+        PlugTracker { first_cut, ..Default::default() }
+    }
+
+    /// Bring the plug's particles up to date with the state at `time`
+    /// (a flood fill only if the cracks or the particles changed).
+    pub fn refresh(&mut self, model: &Model, cracks: &CrackGrowth, axis_x: Real, time: Real) {
         let now = (cracks.events.len(), model.particles.len());
         if self.seen != Some(now) {
             self.particles = plug_particles(model, cracks, axis_x);
             self.seen = Some(now);
+            if self.particles.is_some() && self.first_cut.is_none() {
+                self.first_cut = Some(time);
+            }
         }
+    }
+
+    /// The plug in the state at `time`, if any (see [`find_plug`]).
+    pub fn update(&mut self, model: &Model, cracks: &CrackGrowth, axis_x: Real, time: Real) -> Option<Plug> {
+        self.refresh(model, cracks, axis_x, time);
         self.particles.as_ref().map(|ids| Plug::of(model, ids.clone()))
     }
 }

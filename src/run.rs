@@ -465,8 +465,7 @@ fn time_loop(
         .unwrap_or_default();
     let names: Vec<String> = rigid_velocities.iter().map(|(n, _)| n.clone()).collect();
     let last_contacts = crate::output::last_contact_times(&cfg.out_dir, &names)?;
-    let event_times: Vec<Real> = sim.cracks.iter().flat_map(|c| c.events.iter().map(|e| e.time)).collect();
-    let perforation = crate::output::perforation_time(&cfg.out_dir, &event_times)?;
+    let perforation = crate::output::perforation_time(&cfg.out_dir)?;
     let plug = match (&sim.cracks, crate::output::impact_line(&sim)) {
         (Some(c), Some(axis_x)) => crate::plug::find_plug(&sim.model, c, axis_x),
         _ => None,

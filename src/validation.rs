@@ -13,8 +13,10 @@
 //!   force and no gravity the speed is then constant). Otherwise the row says
 //!   "in contact at the end" with the final speed in brackets.
 //! - **Perforation time**: when the plate is first completely severed — the
-//!   first history row with a plug ([`crate::output::perforation_time`],
-//!   refined to the crack event that cut it out).
+//!   time of the step after which the flood fill of [`crate::plug`] first
+//!   finds a plug (it runs after every step that changed the cracks; the
+//!   `perforation_time` column of `history.csv`,
+//!   [`crate::output::perforation_time`]).
 //! - **Plug mass and velocity**: at the end of the run, the particles that
 //!   the through-cracks cut out under the projectile, found by a flood fill
 //!   the cracks block ([`crate::plug`]); mass in g (g/mm of depth in plane

@@ -157,13 +157,16 @@ fn the_tracker_follows_velocity_and_recomputes_when_the_cracks_change() {
     let mut g = growth();
     let mut t = PlugTracker::default();
     cut(&mut m, &mut g, 8, NY);
-    assert!(t.update(&m, &g, 12.0 * H).is_none());
+    assert!(t.update(&m, &g, 12.0 * H, 1e-6).is_none());
+    assert_eq!(t.first_cut, None);
     cut(&mut m, &mut g, 16, NY);
-    let first = t.update(&m, &g, 12.0 * H).expect("cut out after the second crack");
+    let first = t.update(&m, &g, 12.0 * H, 2e-6).expect("cut out after the second crack");
+    assert_eq!(t.first_cut, Some(2e-6), "perforated when first found");
     for v in m.particles.v.iter_mut() {
         *v = Vec2::new(0.0, -50.0);
     }
-    let second = t.update(&m, &g, 12.0 * H).unwrap();
+    let second = t.update(&m, &g, 12.0 * H, 3e-6).unwrap();
     assert_eq!(first.particles, second.particles);
+    assert_eq!(t.first_cut, Some(2e-6), "the first cut stays");
     assert!((second.velocity() - Vec2::new(0.0, -50.0)).norm() < 1e-9);
 }
