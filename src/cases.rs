@@ -1,5 +1,15 @@
 //! Built-in cases, selectable by name from the CLI (`plugsim run --case NAME`).
 //! Each is the text of a file under `cases/`, so what runs is what users read.
+//!
+//! Børvik's reference cases (\[RL10\] §5, SPEC §10) form one family named
+//! `borvik-<1|2>-<plane-strain|axisymmetric>[-fine][-damage][-modified]`:
+//! Case I or II; the paper's plane-strain model or the true axisymmetric
+//! geometry; the coarse (24 rows) or fine (48 rows) discretization; the
+//! effective-strain (default) or damage crack criterion; \[RL10\]'s material
+//! (default) or Børvik's modified one (axisymmetric fine only). All share one
+//! set of numerical parameters ([`borvik_family`] lists them; the
+//! `tests/reference_cases.rs` suite checks the family is complete and
+//! consistent). [`ALIASES`] name the paper's own models briefly.
 
 /// `(name, case text, one-line description)`.
 pub const BUILTIN_CASES: &[(&str, &str, &str)] = &[
@@ -16,17 +26,102 @@ pub const BUILTIN_CASES: &[(&str, &str, &str)] = &[
     (
         "borvik-1-plane-strain",
         include_str!("../cases/borvik-1-plane-strain.toml"),
-        "Borvik Case I (298 m/s, 11.1 mm Weldox), plane strain, coarse, effective-strain cracks",
+        "Borvik Case I (298 m/s, 11.1 mm), plane strain, coarse, effective-strain cracks",
+    ),
+    (
+        "borvik-1-plane-strain-damage",
+        include_str!("../cases/borvik-1-plane-strain-damage.toml"),
+        "Borvik Case I (298 m/s, 11.1 mm), plane strain, coarse, damage cracks",
     ),
     (
         "borvik-1-plane-strain-fine",
         include_str!("../cases/borvik-1-plane-strain-fine.toml"),
-        "the same with [RL10]'s fine discretization (48 rows, 46,032 particles)",
+        "Borvik Case I (298 m/s, 11.1 mm), plane strain, fine, effective-strain cracks",
+    ),
+    (
+        "borvik-1-plane-strain-fine-damage",
+        include_str!("../cases/borvik-1-plane-strain-fine-damage.toml"),
+        "Borvik Case I (298 m/s, 11.1 mm), plane strain, fine, damage cracks",
     ),
     (
         "borvik-1-axisymmetric",
         include_str!("../cases/borvik-1-axisymmetric.toml"),
-        "Borvik Case I (298 m/s, 11.1 mm Weldox), axisymmetric (197 g cylinder), coarse, effective-strain cracks",
+        "Borvik Case I (298 m/s, 11.1 mm), axisymmetric, coarse, effective-strain cracks",
+    ),
+    (
+        "borvik-1-axisymmetric-damage",
+        include_str!("../cases/borvik-1-axisymmetric-damage.toml"),
+        "Borvik Case I (298 m/s, 11.1 mm), axisymmetric, coarse, damage cracks",
+    ),
+    (
+        "borvik-1-axisymmetric-fine",
+        include_str!("../cases/borvik-1-axisymmetric-fine.toml"),
+        "Borvik Case I (298 m/s, 11.1 mm), axisymmetric, fine, effective-strain cracks",
+    ),
+    (
+        "borvik-1-axisymmetric-fine-damage",
+        include_str!("../cases/borvik-1-axisymmetric-fine-damage.toml"),
+        "Borvik Case I (298 m/s, 11.1 mm), axisymmetric, fine, damage cracks",
+    ),
+    (
+        "borvik-1-axisymmetric-fine-modified",
+        include_str!("../cases/borvik-1-axisymmetric-fine-modified.toml"),
+        "Borvik Case I (298 m/s, 11.1 mm), axisymmetric, fine, effective-strain cracks, Borvik's modified material",
+    ),
+    (
+        "borvik-1-axisymmetric-fine-damage-modified",
+        include_str!("../cases/borvik-1-axisymmetric-fine-damage-modified.toml"),
+        "Borvik Case I (298 m/s, 11.1 mm), axisymmetric, fine, damage cracks, Borvik's modified material",
+    ),
+    (
+        "borvik-2-plane-strain",
+        include_str!("../cases/borvik-2-plane-strain.toml"),
+        "Borvik Case II (173.7 m/s, 10.2 mm), plane strain, coarse, effective-strain cracks",
+    ),
+    (
+        "borvik-2-plane-strain-damage",
+        include_str!("../cases/borvik-2-plane-strain-damage.toml"),
+        "Borvik Case II (173.7 m/s, 10.2 mm), plane strain, coarse, damage cracks",
+    ),
+    (
+        "borvik-2-plane-strain-fine",
+        include_str!("../cases/borvik-2-plane-strain-fine.toml"),
+        "Borvik Case II (173.7 m/s, 10.2 mm), plane strain, fine, effective-strain cracks",
+    ),
+    (
+        "borvik-2-plane-strain-fine-damage",
+        include_str!("../cases/borvik-2-plane-strain-fine-damage.toml"),
+        "Borvik Case II (173.7 m/s, 10.2 mm), plane strain, fine, damage cracks",
+    ),
+    (
+        "borvik-2-axisymmetric",
+        include_str!("../cases/borvik-2-axisymmetric.toml"),
+        "Borvik Case II (173.7 m/s, 10.2 mm), axisymmetric, coarse, effective-strain cracks",
+    ),
+    (
+        "borvik-2-axisymmetric-damage",
+        include_str!("../cases/borvik-2-axisymmetric-damage.toml"),
+        "Borvik Case II (173.7 m/s, 10.2 mm), axisymmetric, coarse, damage cracks",
+    ),
+    (
+        "borvik-2-axisymmetric-fine",
+        include_str!("../cases/borvik-2-axisymmetric-fine.toml"),
+        "Borvik Case II (173.7 m/s, 10.2 mm), axisymmetric, fine, effective-strain cracks",
+    ),
+    (
+        "borvik-2-axisymmetric-fine-damage",
+        include_str!("../cases/borvik-2-axisymmetric-fine-damage.toml"),
+        "Borvik Case II (173.7 m/s, 10.2 mm), axisymmetric, fine, damage cracks",
+    ),
+    (
+        "borvik-2-axisymmetric-fine-modified",
+        include_str!("../cases/borvik-2-axisymmetric-fine-modified.toml"),
+        "Borvik Case II (173.7 m/s, 10.2 mm), axisymmetric, fine, effective-strain cracks, Borvik's modified material",
+    ),
+    (
+        "borvik-2-axisymmetric-fine-damage-modified",
+        include_str!("../cases/borvik-2-axisymmetric-fine-damage-modified.toml"),
+        "Borvik Case II (173.7 m/s, 10.2 mm), axisymmetric, fine, damage cracks, Borvik's modified material",
     ),
     (
         "borvik-1-nofracture",
@@ -35,7 +130,102 @@ pub const BUILTIN_CASES: &[(&str, &str, &str)] = &[
     ),
 ];
 
-/// The text of the built-in case `name`.
+/// Short names for the paper's models: `(alias, built-in case)`.
+pub const ALIASES: &[(&str, &str)] = &[("borvik-1", "borvik-1-plane-strain"), ("borvik-2", "borvik-2-plane-strain")];
+
+/// The built-in material of \[RL10\] (Table 2).
+pub const MATERIAL_RL10: &str = "weldox_460e";
+/// Børvik et al.'s modified fit of the same steel (power rate law).
+pub const MATERIAL_MODIFIED: &str = "weldox_460e_borvik";
+
+/// One member of Børvik's reference family: which experiment, geometry,
+/// discretization, criterion and material a built-in case stands for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BorvikCase {
+    /// 1 or 2: Børvik's Case I (11.1 mm, 298.0 m/s) or II (10.2 mm, 173.7 m/s).
+    pub experiment: u8,
+    /// `"plane_strain"` or `"axisymmetric"`.
+    pub geometry: &'static str,
+    /// `"coarse"` (24 rows) or `"fine"` (48 rows).
+    pub discretization: &'static str,
+    /// `"effective_strain"` or `"damage"`.
+    pub criterion: &'static str,
+    /// The built-in material: [`MATERIAL_RL10`] or [`MATERIAL_MODIFIED`].
+    pub material: &'static str,
+}
+
+impl BorvikCase {
+    /// The built-in case's name,
+    /// `borvik-<1|2>-<plane-strain|axisymmetric>[-fine][-damage][-modified]`.
+    pub fn name(&self) -> String {
+        let mut n = format!("borvik-{}-{}", self.experiment, self.geometry.replace('_', "-"));
+        if self.discretization == "fine" {
+            n.push_str("-fine");
+        }
+        if self.criterion == "damage" {
+            n.push_str("-damage");
+        }
+        if self.material == MATERIAL_MODIFIED {
+            n.push_str("-modified");
+        }
+        n
+    }
+
+    /// Whether this is one of \[RL10\]'s own models (plane strain, its material).
+    pub fn is_papers_model(&self) -> bool {
+        self.geometry == "plane_strain" && self.material == MATERIAL_RL10
+    }
+}
+
+/// The whole reference family, in the order `plugsim validate` reports it:
+/// per case, both geometries × both discretizations × both criteria with
+/// \[RL10\]'s material, then the axisymmetric fine cases with Børvik's
+/// modified material (both criteria): 20 cases.
+pub fn borvik_family() -> Vec<BorvikCase> {
+    let mut v = Vec::new();
+    for experiment in [1, 2] {
+        for geometry in ["plane_strain", "axisymmetric"] {
+            for discretization in ["coarse", "fine"] {
+                for criterion in ["effective_strain", "damage"] {
+                    v.push(BorvikCase { experiment, geometry, discretization, criterion, material: MATERIAL_RL10 });
+                }
+            }
+        }
+        for criterion in ["effective_strain", "damage"] {
+            v.push(BorvikCase {
+                experiment,
+                geometry: "axisymmetric",
+                discretization: "fine",
+                criterion,
+                material: MATERIAL_MODIFIED,
+            });
+        }
+    }
+    v
+}
+
+/// The text of the built-in case `name` (or of the case an alias names).
 pub fn builtin_case(name: &str) -> Option<&'static str> {
+    let name = ALIASES.iter().find(|a| a.0 == name).map_or(name, |a| a.1);
     BUILTIN_CASES.iter().find(|c| c.0 == name).map(|c| c.1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_family_member_and_alias_is_built_in() {
+        let family = borvik_family();
+        assert_eq!(family.len(), 20);
+        for m in &family {
+            assert!(builtin_case(&m.name()).is_some(), "{} is not built in", m.name());
+        }
+        for (alias, name) in ALIASES {
+            assert_eq!(builtin_case(alias), builtin_case(name));
+            assert!(builtin_case(name).is_some());
+        }
+        assert_eq!(family[0].name(), "borvik-1-plane-strain");
+        assert_eq!(family[19].name(), "borvik-2-axisymmetric-fine-damage-modified");
+    }
 }

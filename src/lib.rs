@@ -20,6 +20,7 @@ pub mod model;
 pub mod neighbors;
 pub mod output;
 pub mod particles;
+pub mod plug;
 pub mod quadrature;
 pub mod run;
 pub mod shape;

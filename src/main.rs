@@ -4,7 +4,7 @@ use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use plugsim::case::Case;
-use plugsim::cases::{builtin_case, BUILTIN_CASES};
+use plugsim::cases::{builtin_case, ALIASES, BUILTIN_CASES};
 use plugsim::run::{execute, resume, Progress, RunConfig, RunError, RunInfo, RunSummary};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -63,7 +63,12 @@ enum Command {
         /// Output directory for the runs and the report.
         #[arg(long, default_value = "runs/validation")]
         out: PathBuf,
-        /// Only the rows whose id contains this text (e.g. case-1, axisymmetric).
+        /// Run every row: fine discretizations and Borvik's modified material too.
+        #[arg(long)]
+        all: bool,
+        /// Only this row (a built-in case name such as borvik-1-axisymmetric, or
+        /// the alias borvik-1), else the rows whose name contains this text
+        /// (e.g. borvik-2, damage, fine); chosen among all rows.
         #[arg(long)]
         only: Option<String>,
     },
@@ -168,12 +173,15 @@ fn dispatch(cmd: Command) -> Result<()> {
     match cmd {
         Command::Cases => {
             for (name, _, about) in BUILTIN_CASES {
-                println!("{name:28} {about}");
+                println!("{name:44} {about}");
+            }
+            for (alias, name) in ALIASES {
+                println!("{alias:44} = {name}");
             }
             Ok(())
         }
         Command::Bench { case, steps, whole, set } => bench(&case, steps, whole, &set),
-        Command::Validate { out, only } => validate(&out, only.as_deref()),
+        Command::Validate { out, all, only } => validate(&out, all, only.as_deref()),
         Command::MaterialPoint { material, case_file, path, rate, strain, dt, out } => {
             material_point(&material, case_file.as_deref(), path, rate, strain, dt, &out)
         }
@@ -271,20 +279,39 @@ fn material_point(
     Ok(())
 }
 
-fn validate(out: &Path, only: Option<&str>) -> Result<()> {
-    use plugsim::validation::{coarse_rows, run_row, table, velocity_plot, EXPERIMENTS};
-    let rows: Vec<_> = coarse_rows().into_iter().filter(|r| only.is_none_or(|o| r.id.contains(o))).collect();
+fn validate(out: &Path, all: bool, only: Option<&str>) -> Result<()> {
+    use plugsim::validation::{all_rows, coarse_rows, report, run_row, select, table, velocity_plot, EXPERIMENTS};
+    let rows = match only {
+        Some(o) => select(all_rows(), o),
+        None if all => all_rows(),
+        None => coarse_rows(),
+    };
     if rows.is_empty() {
-        bail!("no validation row matches {only:?}");
+        bail!("no validation row matches {only:?} (see `plugsim cases`, the borvik-* names)");
     }
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     eprintln!("plugsim validate: {} runs into {}", rows.len(), out.display());
     let mut outcomes = Vec::new();
     for (k, row) in rows.iter().enumerate() {
         eprintln!("  [{}/{}] {} ...", k + 1, rows.len(), row.id);
-        outcomes.push(run_row(row, out, &mut |_| {}));
+        let o = run_row(row, out);
+        eprintln!(
+            "        {:.1} s{}",
+            o.wall,
+            o.result.as_ref().err().map(|e| format!(", failed: {e}")).unwrap_or_default()
+        );
+        outcomes.push(o);
     }
-    let (md, csv) = table(&outcomes);
+    let (_, csv) = table(&outcomes);
+    let mut velocity_plots = Vec::new();
+    for e in EXPERIMENTS {
+        let plot = velocity_plot(&outcomes, e);
+        if !plot.series.is_empty() {
+            let name = format!("velocity_{}.png", e.name);
+            plugsim::io::save_line_plot(&out.join(&name), &plot)?;
+            velocity_plots.push(name);
+        }
+    }
     let commit = env!("PLUGSIM_COMMIT");
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
@@ -294,23 +321,16 @@ fn validate(out: &Path, only: Option<&str>) -> Result<()> {
                 .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
         })
         .unwrap_or_else(|| "unknown CPU".into());
-    let report = format!(
-        "Produced by `plugsim validate` ({} {commit}) on {cpu}, {} threads.\n\n{md}",
+    let header = format!(
+        "Produced by `plugsim validate` ({} {commit}) on {cpu}, {} threads.",
         env!("CARGO_PKG_VERSION"),
         rayon::current_num_threads()
     );
-    std::fs::write(out.join("validation.md"), &report)?;
+    let md = report(&header, &outcomes, &velocity_plots);
+    std::fs::write(out.join("validation.md"), &md)?;
     std::fs::write(out.join("validation.csv"), &csv)?;
-    for e in EXPERIMENTS {
-        let plot = velocity_plot(&outcomes, e);
-        if !plot.series.is_empty() {
-            let path = out.join(format!("velocity_{}.png", e.name));
-            plugsim::io::save_line_plot(&path, &plot)?;
-            println!("plot: {}", path.display());
-        }
-    }
-    println!("{report}");
-    println!("written: {0}/validation.md, {0}/validation.csv", out.display());
+    println!("{md}");
+    println!("written: {0}/validation.md, {0}/validation.csv and the plots beside them", out.display());
     Ok(())
 }
 
@@ -550,8 +570,23 @@ fn drive(
     }
     if let Some(t) = s.separation {
         println!("  plug separated at {:.3} us (its cracks arrested through the thickness)", t * 1e6);
-    } else if !s.cracks.is_empty() {
-        println!("  plug not separated");
+    }
+    if let Some(t) = s.perforation {
+        println!("  plate perforated at {:.3} us (plug first cut out)", t * 1e6);
+    }
+    match &s.plug {
+        Some(p) => {
+            let v = p.velocity();
+            println!(
+                "  plug at the end: {} particles, mass {:.4e} kg (per metre of depth in plane strain), velocity ({:.2}, {:.2}) m/s",
+                p.particles.len(),
+                p.mass,
+                v.x,
+                v.y
+            );
+        }
+        None if !s.cracks.is_empty() => println!("  no plug cut out"),
+        None => {}
     }
     println!("  output: {} snapshots in {}/results.pvd, history in history.csv", s.snapshots, s.out_dir.display());
     for p in &s.plots {

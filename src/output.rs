@@ -13,8 +13,12 @@ use crate::model::Model;
 use crate::step::Simulation;
 use std::path::{Path, PathBuf};
 
-/// Columns of the history CSV that every run has, in order; each rigid
-/// body `NAME` adds `NAME_x, NAME_y` (m), `NAME_vx, NAME_vy` (m/s),
+/// Columns of the history CSV that every run has, in order: time, step,
+/// energies, and the plug once cracks have cut one out under the first
+/// rigid body (`plug_mass`, kg or kg/m in plane strain, and its
+/// mass-averaged velocity `plug_vx, plug_vy`, m/s; all 0 before, see
+/// [`crate::plug`]) with `perforation_time`, the time of the step after
+/// which it was first found (s; 0 before). Each rigid body `NAME` adds `NAME_x, NAME_y` (m), `NAME_vx, NAME_vy` (m/s),
 /// `NAME_fx, NAME_fy` (contact force on the body, N) and `NAME_contacts`.
 pub const HISTORY_COLUMNS: &[&str] = &[
     "time",
@@ -27,6 +31,10 @@ pub const HISTORY_COLUMNS: &[&str] = &[
     "contact_dissipation",
     "total_energy",
     "energy_drift",
+    "plug_mass",
+    "plug_vx",
+    "plug_vy",
+    "perforation_time",
 ];
 
 /// Columns of `cracks.csv`: one row per crack event; `particles` lists the
@@ -61,6 +69,10 @@ pub struct OutputWriter {
     crack_log: Option<std::io::BufWriter<std::fs::File>>,
     /// Crack events written so far.
     crack_events_written: usize,
+    /// The plug, followed from step to step.
+    plug: crate::plug::PlugTracker,
+    /// Step of the last history row (a step gets at most one).
+    last_row_step: Option<u64>,
 }
 
 impl OutputWriter {
@@ -76,6 +88,8 @@ impl OutputWriter {
             snapshots: 0,
             crack_log: None,
             crack_events_written: 0,
+            plug: Default::default(),
+            last_row_step: None,
         })
     }
 
@@ -97,6 +111,11 @@ impl OutputWriter {
         let cols = history_columns(rigid_names);
         let cols: Vec<&str> = cols.iter().map(|s| s.as_str()).collect();
         let history = HistoryWriter::continue_at(&dir.join("history.csv"), &cols, history_bytes)?;
+        // The perforation time so far is in the rows kept (the last row's
+        // column: the row of the step that cut the plug out is always written).
+        let kept = crate::io::HistoryTable::read(&dir.join("history.csv"))?;
+        let first_cut = kept.column("perforation_time").and_then(|c| c.last().copied()).filter(|&t| t > 0.0);
+        let last_row_step = kept.column("step").and_then(|c| c.last().copied()).map(|s| s as u64);
         // In the order `snapshot` appends them: by time, then part.
         let entries = snapshot_times
             .iter()
@@ -130,6 +149,8 @@ impl OutputWriter {
             snapshots: n,
             crack_log: None,
             crack_events_written: 0,
+            plug: crate::plug::PlugTracker::continuing(first_cut),
+            last_row_step,
         };
         let log = dir.join("cracks.csv");
         match cracks {
@@ -178,8 +199,12 @@ impl OutputWriter {
         Ok(path)
     }
 
-    /// Append one history row.
+    /// Append one history row (none if this step has one already).
     pub fn history_row(&mut self, sim: &Simulation) -> Result<(), IoError> {
+        if self.last_row_step == Some(sim.step) {
+            return Ok(());
+        }
+        self.last_row_step = Some(sim.step);
         let e = &sim.energies;
         let mut row = vec![
             sim.time,
@@ -193,6 +218,15 @@ impl OutputWriter {
             e.total(),
             e.drift(),
         ];
+        let plug = match (&sim.cracks, impact_line(sim)) {
+            (Some(cracks), Some(axis_x)) => self.plug.update(&sim.model, cracks, axis_x, sim.time),
+            _ => None,
+        };
+        match plug {
+            Some(p) => row.extend([p.mass, p.velocity().x, p.velocity().y]),
+            None => row.extend([0.0; 3]),
+        }
+        row.push(self.plug.first_cut.unwrap_or(0.0));
         if let Some(c) = &sim.contact {
             for b in 0..c.bodies.len() {
                 let s = c.sample(b).expect("body exists");
@@ -212,13 +246,25 @@ impl OutputWriter {
 }
 
 impl OutputWriter {
-    /// Append the crack events not yet written to `cracks.csv` (created at
-    /// the first event, with the header [`CRACK_COLUMNS`]).
+    /// After every step: append the crack events not yet written to
+    /// `cracks.csv` (created at the first event, with the header
+    /// [`CRACK_COLUMNS`]) and, if the cracks changed, look for the plug, so
+    /// that the perforation time is that of the step that cut it out; that
+    /// step gets a history row of its own (so a resumed run finds the
+    /// perforation time in the rows before its checkpoint).
     pub fn crack_events(&mut self, sim: &Simulation) -> Result<(), IoError> {
-        match &sim.cracks {
-            Some(cracks) => self.write_crack_events(cracks),
-            None => Ok(()),
+        let Some(cracks) = &sim.cracks else {
+            return Ok(());
+        };
+        self.write_crack_events(cracks)?;
+        if let Some(axis_x) = impact_line(sim) {
+            let before = self.plug.first_cut;
+            self.plug.refresh(&sim.model, cracks, axis_x, sim.time);
+            if before.is_none() && self.plug.first_cut.is_some() {
+                self.history_row(sim)?;
+            }
         }
+        Ok(())
     }
 
     /// Append the events of `cracks` not yet written to `cracks.csv`.
@@ -265,6 +311,12 @@ pub fn crack_piece(model: &Model, cracks: &crate::fracture::CrackGrowth) -> VtuP
     VtuPiece::poly_lines(points, lines)
         .with_cell_data(DataArray::integers("crack", ids))
         .with_cell_data(DataArray::integers("face", faces))
+}
+
+/// The impact line `x = x_c` of the first rigid body (the x-centre of its
+/// outline), under which [`crate::plug`] looks for the plug.
+pub fn impact_line(sim: &Simulation) -> Option<Real> {
+    projectile_extent(sim).map(|(lo, hi)| 0.5 * (lo + hi))
 }
 
 /// File name of snapshot `k`.
@@ -408,17 +460,38 @@ pub fn field_plot(sim: &Simulation, field: &str, window: Option<[Real; 4]>) -> O
     })
 }
 
+/// Extent `(x_min, x_max)` of the first rigid body's outline now, m.
+fn projectile_extent(sim: &Simulation) -> Option<(Real, Real)> {
+    let b = sim.contact.as_ref()?.bodies.first()?;
+    let (lo, hi) =
+        b.outline().iter().fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), v| (lo.min(v.x), hi.max(v.x)));
+    Some((b.position.x + lo, b.position.x + hi))
+}
+
+/// The view around the first rigid body: ±1.5 projectile widths about its
+/// centre line, the whole thickness.
+fn impact_window(sim: &Simulation) -> Option<[Real; 4]> {
+    projectile_extent(sim).map(|(lo, hi)| {
+        let (w, cx) = (hi - lo, 0.5 * (lo + hi));
+        [cx - 1.5 * w, cx + 1.5 * w, Real::NEG_INFINITY, Real::INFINITY]
+    })
+}
+
+/// The view of the shear band at the projectile's right-hand corner: a
+/// quarter of the projectile's width on either side of its edge, the whole
+/// thickness (in axisymmetry the right-hand edge is the rim, r = radius).
+fn shear_band_window(sim: &Simulation) -> Option<[Real; 4]> {
+    projectile_extent(sim).map(|(lo, hi)| {
+        let q = 0.25 * (hi - lo);
+        [hi - q, hi + q, Real::NEG_INFINITY, Real::INFINITY]
+    })
+}
+
 /// End-of-run field plots (`effective_stress.png`, `temperature.png`) of the
-/// region around the first rigid body (±2 projectile widths), or of
+/// region around the first rigid body (±1.5 projectile widths), or of
 /// everything without one.
 pub fn plot_fields(sim: &Simulation, dir: &Path) -> Result<Vec<PathBuf>, crate::run::RunError> {
-    let window = sim.contact.as_ref().and_then(|c| c.bodies.first()).map(|b| {
-        let (lo, hi) =
-            b.outline().iter().fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), v| (lo.min(v.x), hi.max(v.x)));
-        let w = hi - lo;
-        let cx = b.position.x + 0.5 * (lo + hi);
-        [cx - 1.5 * w, cx + 1.5 * w, Real::NEG_INFINITY, Real::INFINITY]
-    });
+    let window = impact_window(sim);
     let mut written = Vec::new();
     for field in ["effective_stress", "temperature"] {
         if let Some(plot) = field_plot(sim, field, window) {
@@ -428,6 +501,44 @@ pub fn plot_fields(sim: &Simulation, dir: &Path) -> Result<Vec<PathBuf>, crate::
         }
     }
     Ok(written)
+}
+
+/// Label of a plot time in file names: `28us`, `28.5us` (to 0.1 µs).
+pub fn time_label(t: Real) -> String {
+    let tenths = (t * 1e7).round();
+    if tenths % 10.0 == 0.0 {
+        format!("{:.0}us", tenths / 10.0)
+    } else {
+        format!("{:.1}us", tenths / 10.0)
+    }
+}
+
+/// The field plots asked for at time `at` (`output.plot_times`), drawn from
+/// the current state (the first at or after `at`): the deformed bodies
+/// around the first rigid body coloured by effective stress, with the
+/// cracks (`effective_stress_<at>.png`), and the temperature of the shear
+/// band at the projectile's corner (`temperature_<at>.png`, see
+/// [`time_label`]); both fields over everything without a rigid body.
+pub fn plot_fields_at(sim: &Simulation, dir: &Path, at: Real) -> Result<Vec<PathBuf>, crate::run::RunError> {
+    let label = time_label(at);
+    let mut written = Vec::new();
+    for (field, window) in [("effective_stress", impact_window(sim)), ("temperature", shear_band_window(sim))] {
+        if let Some(plot) = field_plot(sim, field, window) {
+            let path = dir.join(format!("{field}_{label}.png"));
+            crate::io::save_field_plot(&path, &plot)?;
+            written.push(path);
+        }
+    }
+    Ok(written)
+}
+
+/// The perforation time of the run in `dir`: when the plug was first cut
+/// out (the `perforation_time` column of the last `history.csv` row; the
+/// plug is looked for after every step that changed the cracks). `None` if
+/// no plug was cut out.
+pub fn perforation_time(dir: &Path) -> Result<Option<Real>, IoError> {
+    let table = crate::io::HistoryTable::read(&dir.join("history.csv"))?;
+    Ok(table.column("perforation_time").and_then(|c| c.last().copied()).filter(|&t| t > 0.0))
 }
 
 /// When each rigid body was last in contact, from the run's `history.csv`
@@ -466,5 +577,29 @@ mod tests {
         let got = last_contact_times(&dir, &["p".into(), "q".into()]).unwrap();
         assert_eq!(got, vec![("p".to_string(), Some(3.0)), ("q".to_string(), None)]);
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn perforation_time_is_read_from_the_last_history_row() {
+        let dir = std::env::temp_dir().join(format!("plugsim-perforation-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut h = HistoryWriter::create(&dir.join("history.csv"), &["time", "perforation_time"]).unwrap();
+        for (t, p) in [(0.0, 0.0), (1.0, 0.0), (2.0, 1.7), (3.0, 1.7)] {
+            h.write_row(&[t, p]).unwrap();
+        }
+        drop(h);
+        assert_eq!(perforation_time(&dir).unwrap(), Some(1.7));
+        let mut h = HistoryWriter::create(&dir.join("history.csv"), &["time", "perforation_time"]).unwrap();
+        h.write_row(&[0.0, 0.0]).unwrap();
+        drop(h);
+        assert_eq!(perforation_time(&dir).unwrap(), None);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn plot_time_labels() {
+        assert_eq!(time_label(28e-6), "28us");
+        assert_eq!(time_label(46.0e-6 + 1e-12), "46us");
+        assert_eq!(time_label(28.5e-6), "28.5us");
     }
 }

@@ -92,6 +92,12 @@ pub struct RunSummary {
     pub cracks: Vec<(usize, Real, Option<Real>)>,
     /// When the plug separated (all cracks that cut it out arrested), s.
     pub separation: Option<Real>,
+    /// Perforation: when the plug was first cut out of the plate (see
+    /// [`crate::output::perforation_time`]), s.
+    pub perforation: Option<Real>,
+    /// The plug at the end of the run, if the cracks cut one out under the
+    /// first rigid body ([`crate::plug`]).
+    pub plug: Option<crate::plug::Plug>,
     /// Velocity of each rigid body at the end, (name, (vx, vy)) m/s.
     pub rigid_velocities: Vec<(String, [Real; 2])>,
     /// Time of each rigid body's last contact (history rows), s.
@@ -372,6 +378,11 @@ fn time_loop(
     let report_every = (steps_estimate / 200).max(1);
     let (ckpt_interval, wall_interval) = (case.checkpoint.interval, case.checkpoint.wall_interval);
     let mut last_checkpoint = Instant::now();
+    let mut plots = Vec::new();
+    // Plot times still to draw (a resumed run drew those up to its checkpoint state).
+    let mut plot_times: Vec<Real> =
+        case.output.plot_times.iter().cloned().filter(|&t| !outputs_done || t - 0.5 * sim.dt > sim.time).collect();
+    plot_times.sort_by(|a, b| b.total_cmp(a));
     loop {
         let done = sim.time >= end - 0.5 * sim.dt;
         if !outputs_done {
@@ -385,6 +396,12 @@ fn time_loop(
                 let t = Instant::now();
                 out.history_row(&sim)?;
                 schedule.max_drift = schedule.max_drift.max(sim.energies.drift().abs());
+                output_wall += t.elapsed();
+            }
+            while let Some(&at) = plot_times.last().filter(|&&at| sim.time >= at - 0.5 * sim.dt) {
+                let t = Instant::now();
+                plots.extend(crate::output::plot_fields_at(&sim, &cfg.out_dir, at)?);
+                plot_times.pop();
                 output_wall += t.elapsed();
             }
         }
@@ -431,7 +448,7 @@ fn time_loop(
     let loop_wall = t_loop.elapsed().saturating_sub(output_wall);
     progress(Progress::Finished { sim: &sim });
     let t = Instant::now();
-    let mut plots = crate::output::plot_history(&cfg.out_dir)?;
+    plots.extend(crate::output::plot_history(&cfg.out_dir)?);
     plots.extend(crate::output::plot_fields(&sim, &cfg.out_dir)?);
     output_wall += t.elapsed();
     let (cracks, separation) = match &sim.cracks {
@@ -448,7 +465,14 @@ fn time_loop(
         .unwrap_or_default();
     let names: Vec<String> = rigid_velocities.iter().map(|(n, _)| n.clone()).collect();
     let last_contacts = crate::output::last_contact_times(&cfg.out_dir, &names)?;
+    let perforation = crate::output::perforation_time(&cfg.out_dir)?;
+    let plug = match (&sim.cracks, crate::output::impact_line(&sim)) {
+        (Some(c), Some(axis_x)) => crate::plug::find_plug(&sim.model, c, axis_x),
+        _ => None,
+    };
     Ok(RunSummary {
+        perforation,
+        plug,
         cracks,
         separation,
         rigid_velocities,

@@ -1,20 +1,42 @@
-//! `plugsim validate`: run Børvik's plugging cases and compare the
-//! projectile's residual velocity with the experiments and with [RL10]'s
-//! simulations (shared/reference/ren-li-2010.toml, Tables 1 and 3).
+//! `plugsim validate`: run Børvik's plugging cases (the built-in `borvik-*`
+//! family, [`crate::cases::borvik_family`]) and compare the projectile's
+//! residual velocity with the experiments and with \[RL10\]'s simulations
+//! (shared/reference/ren-li-2010.toml, Tables 1 and 3).
 //!
-//! Residual velocity is measured as experimenters do: the projectile's speed
-//! once contact forces have vanished. A row reports the speed at the end of
-//! the run and the time of the last contact; if the projectile is still in
-//! contact at the end, the row says so rather than reporting a number.
+//! What each row measures, as experimenters do:
+//! - **Residual velocity**: the projectile's speed once contact forces have
+//!   vanished. Detected from the run's `history.csv`: the last row whose
+//!   `projectile_contacts` (slave particles pushing on the projectile, i.e.
+//!   a non-zero contact force) is positive is the *last contact*; the
+//!   residual is the speed at the end of the run, reported only if the run
+//!   went on for at least [`FREE_FLIGHT`] after the last contact (with no
+//!   force and no gravity the speed is then constant). Otherwise the row says
+//!   "in contact at the end" with the final speed in brackets.
+//! - **Perforation time**: when the plate is first completely severed — the
+//!   time of the step after which the flood fill of [`crate::plug`] first
+//!   finds a plug (it runs after every step that changed the cracks; the
+//!   `perforation_time` column of `history.csv`,
+//!   [`crate::output::perforation_time`]).
+//! - **Plug mass and velocity**: at the end of the run, the particles that
+//!   the through-cracks cut out under the projectile, found by a flood fill
+//!   the cracks block ([`crate::plug`]); mass in g (g/mm of depth in plane
+//!   strain), velocity the mass average of its particles along the impact
+//!   direction.
 
 use crate::case::Case;
-use crate::cases::builtin_case;
+use crate::cases::{borvik_family, builtin_case, BorvikCase};
 use crate::io::{HistoryTable, LinePlot, Series};
 use crate::math::Real;
 use crate::run::{execute, RunConfig, RunError, RunInfo, RunSummary};
 use std::path::{Path, PathBuf};
 
-/// One of Børvik's experiments as printed in [RL10] (reference file).
+/// How long the projectile must fly free of contact before the end of the
+/// run for its speed to count as the residual velocity, s: several history
+/// rows (a row every ten steps of about 0.04 µs), so a contact that only
+/// paused between two rows is not taken for the end of contact.
+pub const FREE_FLIGHT: Real = 1.0e-6;
+
+/// One of Børvik's experiments as printed in \[RL10\] (reference file).
 #[derive(Clone, Debug)]
 pub struct Experiment {
     pub name: &'static str,
@@ -24,13 +46,15 @@ pub struct Experiment {
     pub impact_velocity: Real,
     /// Measured residual velocity, m/s.
     pub residual: Real,
-    /// Time simulated by [RL10], s.
+    /// Time simulated by \[RL10\], s.
     pub simulated_time: Real,
-    /// [RL10]'s simulated residuals: (particles, criterion, m/s).
+    /// Perforation time in \[RL10\]'s simulation (a crack through the plate), s.
+    pub perforation_time: Real,
+    /// \[RL10\]'s simulated residuals: (particles, criterion, m/s).
     pub paper: &'static [(usize, &'static str, Real)],
 }
 
-/// Tables 1 and 3 of [RL10] (`shared/reference/ren-li-2010.toml`).
+/// Tables 1 and 3 of \[RL10\] (`shared/reference/ren-li-2010.toml`).
 pub const EXPERIMENTS: &[Experiment] = &[
     Experiment {
         name: "case-1",
@@ -38,6 +62,7 @@ pub const EXPERIMENTS: &[Experiment] = &[
         impact_velocity: 298.0,
         residual: 241.4,
         simulated_time: 118.0e-6,
+        perforation_time: 28.0e-6,
         paper: &[
             (11496, "damage", 238.5),
             (11496, "effective_strain", 246.7),
@@ -51,6 +76,7 @@ pub const EXPERIMENTS: &[Experiment] = &[
         impact_velocity: 173.7,
         residual: 112.0,
         simulated_time: 216.0e-6,
+        perforation_time: 46.0e-6,
         paper: &[
             (11496, "damage", 123.0),
             (11496, "effective_strain", 121.8),
@@ -60,53 +86,42 @@ pub const EXPERIMENTS: &[Experiment] = &[
     },
 ];
 
-/// A validation row: a built-in case, overrides, and its experiment.
+/// A validation row: a built-in case of the Børvik family and its experiment.
 #[derive(Clone, Debug)]
 pub struct Row {
+    /// The built-in case's name (also the run's directory).
     pub id: String,
     pub experiment: &'static Experiment,
-    pub geometry: &'static str,
-    pub discretization: &'static str,
-    pub criterion: &'static str,
-    pub builtin: &'static str,
-    pub overrides: Vec<String>,
+    pub case: BorvikCase,
 }
 
-/// The coarse rows: both cases, plane strain and axisymmetric, both
-/// criteria. Case II is Case I's files with the thinner plate, the slower
-/// projectile (its nose again 0.05 mm above the plate) and the longer time.
-pub fn coarse_rows() -> Vec<Row> {
-    let mut rows = Vec::new();
-    for e in EXPERIMENTS {
-        for (geometry, builtin) in
-            [("plane_strain", "borvik-1-plane-strain"), ("axisymmetric", "borvik-1-axisymmetric")]
-        {
-            for criterion in ["effective_strain", "damage"] {
-                let t = e.thickness;
-                let mut o = vec![
-                    format!("time.end={:e}", e.simulated_time),
-                    format!("fracture.criterion=\"{criterion}\""),
-                    format!("bodies.plate.rectangle.y_max={t}"),
-                    format!("bodies.plate.supports.0.region.y_max={t}"),
-                    format!("rigid_bodies.projectile.velocity=[0.0, {}]", -e.impact_velocity),
-                    format!("rigid_bodies.projectile.rectangle.center=[0.0, {}]", t + 0.04 + 5e-5),
-                ];
-                if geometry == "plane_strain" {
-                    o.push(format!("bodies.plate.supports.1.region.y_max={t}"));
-                }
-                rows.push(Row {
-                    id: format!("{}-{}-coarse-{}", e.name, geometry, criterion),
-                    experiment: e,
-                    geometry,
-                    discretization: "coarse",
-                    criterion,
-                    builtin,
-                    overrides: o,
-                });
-            }
-        }
+impl Row {
+    fn of(case: BorvikCase) -> Row {
+        Row { id: case.name(), experiment: &EXPERIMENTS[case.experiment as usize - 1], case }
     }
-    rows
+}
+
+/// Every row: the whole family, in its order (20 rows).
+pub fn all_rows() -> Vec<Row> {
+    borvik_family().into_iter().map(Row::of).collect()
+}
+
+/// The coarse rows (what `plugsim validate` runs by default): both cases,
+/// both geometries, both criteria (8 rows).
+pub fn coarse_rows() -> Vec<Row> {
+    all_rows().into_iter().filter(|r| r.case.discretization == "coarse").collect()
+}
+
+/// The rows `--only TEXT` selects from `rows`: the row named exactly `TEXT`
+/// (or the case an alias such as `borvik-1` names) if there is one, else
+/// every row whose name contains `TEXT`.
+pub fn select(rows: Vec<Row>, only: &str) -> Vec<Row> {
+    let target = crate::cases::ALIASES.iter().find(|a| a.0 == only).map_or(only, |a| a.1);
+    if rows.iter().any(|r| r.id == target) {
+        rows.into_iter().filter(|r| r.id == target).collect()
+    } else {
+        rows.into_iter().filter(|r| r.id.contains(only)).collect()
+    }
 }
 
 /// What a row produced.
@@ -114,6 +129,7 @@ pub fn coarse_rows() -> Vec<Row> {
 pub struct Outcome {
     pub row: Row,
     pub result: Result<RunSummary, String>,
+    /// Wall time of the run, s.
     pub wall: Real,
     /// Projectile speed at the end, m/s.
     pub final_speed: Option<Real>,
@@ -124,32 +140,51 @@ pub struct Outcome {
 
 impl Outcome {
     /// The residual velocity: the final speed if the projectile had left
-    /// contact before the end of the run.
+    /// contact at least [`FREE_FLIGHT`] before the end of the run (module doc).
     pub fn residual(&self) -> Option<Real> {
         let s = self.result.as_ref().ok()?;
         match (self.final_speed, self.last_contact) {
-            (Some(v), Some(t)) if s.time - t > 1e-6 => Some(v),
+            (Some(v), Some(t)) if s.time - t >= FREE_FLIGHT => Some(v),
             (Some(v), None) => Some(v),
             _ => None,
         }
     }
-    /// [RL10]'s value for this row (plane strain only; coarse = 11,496 particles).
+
+    /// \[RL10\]'s value for this row: its own model (plane strain, its
+    /// material) only; coarse = 11,496 particles, fine = 45,984.
     pub fn paper(&self) -> Option<Real> {
-        if self.row.geometry != "plane_strain" {
+        if !self.row.case.is_papers_model() {
             return None;
         }
-        let particles = if self.row.discretization == "coarse" { 11496 } else { 45984 };
-        self.row.experiment.paper.iter().find(|p| p.0 == particles && p.1 == self.row.criterion).map(|p| p.2)
+        let particles = if self.row.case.discretization == "coarse" { 11496 } else { 45984 };
+        self.row.experiment.paper.iter().find(|p| p.0 == particles && p.1 == self.row.case.criterion).map(|p| p.2)
+    }
+
+    /// Perforation time, s.
+    pub fn perforation(&self) -> Option<Real> {
+        self.result.as_ref().ok()?.perforation
+    }
+
+    /// Plug mass at the end: g in axisymmetry, g per mm of depth in plane
+    /// strain (numerically the kg/m of the run).
+    pub fn plug_mass(&self) -> Option<Real> {
+        let plug = self.result.as_ref().ok()?.plug.as_ref()?;
+        Some(if self.row.case.geometry == "axisymmetric" { plug.mass * 1e3 } else { plug.mass })
+    }
+
+    /// Plug speed along the impact direction (−y) at the end, m/s.
+    pub fn plug_speed(&self) -> Option<Real> {
+        Some(-self.result.as_ref().ok()?.plug.as_ref()?.velocity().y)
     }
 }
 
 /// Run one row into `out/ROW_ID`.
-pub fn run_row(row: &Row, out: &Path, progress: &mut dyn FnMut(&str)) -> Outcome {
+pub fn run_row(row: &Row, out: &Path) -> Outcome {
     let dir = out.join(&row.id);
     let t = std::time::Instant::now();
-    let text = builtin_case(row.builtin).expect("validation rows name built-in cases");
-    let result = Case::from_str_with(text, row.builtin, &row.overrides).map_err(|e| e.to_string()).and_then(|case| {
-        let cfg = RunConfig::new(dir.clone(), true, RunInfo::current(row.builtin, &row.overrides));
+    let text = builtin_case(&row.id).expect("validation rows name built-in cases");
+    let result = Case::from_str_with(text, &row.id, &[]).map_err(|e| e.to_string()).and_then(|case| {
+        let cfg = RunConfig::new(dir.clone(), true, RunInfo::current(&row.id, &[]));
         execute(&case, &cfg, &mut |_| {}).map_err(|e: RunError| e.to_string())
     });
     let wall = t.elapsed().as_secs_f64();
@@ -160,7 +195,6 @@ pub fn run_row(row: &Row, out: &Path, progress: &mut dyn FnMut(&str)) -> Outcome
         ),
         Err(_) => (None, None),
     };
-    progress(&row.id);
     Outcome { row: row.clone(), result, wall, final_speed, last_contact, out_dir: dir }
 }
 
@@ -168,33 +202,50 @@ fn fmt_opt(v: Option<Real>, digits: usize) -> String {
     v.map_or_else(|| "—".to_string(), |v| format!("{v:.digits$}"))
 }
 
+fn fmt_csv(v: Option<Real>, digits: usize) -> String {
+    v.map_or_else(String::new, |v| format!("{v:.digits$}"))
+}
+
+/// Short name of a row's material.
+fn material_label(case: &BorvikCase) -> &'static str {
+    if case.material == crate::cases::MATERIAL_MODIFIED {
+        "modified"
+    } else {
+        "RL10"
+    }
+}
+
 /// The table as Markdown and CSV.
 pub fn table(outcomes: &[Outcome]) -> (String, String) {
     let mut md = String::from(
-        "| case | geometry | discretization | criterion | particles | steps | wall (s) | residual (m/s) | experiment (m/s) | error % | [RL10] (m/s) | perforation (µs) | last contact (µs) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| case | geometry | discretization | criterion | material | particles | steps | wall (s) | residual (m/s) | experiment (m/s) | error % | [RL10] (m/s) | perforation (µs) | [RL10] perforation (µs) | plug mass (g; g/mm in plane strain) | plug velocity (m/s) | last contact (µs) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let mut csv = String::from(
-        "case,geometry,discretization,criterion,particles,steps,wall_s,residual_m_s,experiment_m_s,error_percent,paper_m_s,perforation_us,last_contact_us,status\n",
+        "row,case,geometry,discretization,criterion,material,particles,steps,wall_s,residual_m_s,experiment_m_s,error_percent,paper_m_s,perforation_us,paper_perforation_us,plug_mass,plug_velocity_m_s,last_contact_us,status\n",
     );
     for o in outcomes {
-        let r = &o.row;
+        let (r, c) = (&o.row, &o.row.case);
         let residual = o.residual();
         let err = residual.map(|v| 100.0 * (v - r.experiment.residual) / r.experiment.residual);
-        let (particles, steps, perforation, status) = match &o.result {
-            Ok(s) => (s.particles.to_string(), s.steps.to_string(), s.separation.map(|t| t * 1e6), "ok".to_string()),
-            Err(e) => ("—".into(), "—".into(), None, format!("failed: {}", e.lines().next().unwrap_or(""))),
+        let (particles, steps, status) = match &o.result {
+            Ok(s) => (s.particles.to_string(), s.steps.to_string(), "ok".to_string()),
+            Err(e) => ("—".into(), "—".into(), format!("failed: {}", e.lines().next().unwrap_or(""))),
         };
         let residual_md = match (&o.result, residual) {
             (Err(_), _) => format!("failed ({})", status.trim_start_matches("failed: ")),
             (Ok(_), None) => format!("in contact at the end ({} m/s)", fmt_opt(o.final_speed, 1)),
             (Ok(_), Some(v)) => format!("{v:.1}"),
         };
+        let paper_perforation = r.experiment.perforation_time * 1e6;
+        let perforation = o.perforation().map(|t| t * 1e6);
+        let last_contact = o.last_contact.map(|t| t * 1e6);
         md.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {:.1} | {} | {:.1} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {} | {:.1} | {} | {} | {} | {:.0} | {} | {} | {} |\n",
             r.experiment.name,
-            r.geometry,
-            r.discretization,
-            r.criterion,
+            c.geometry,
+            c.discretization,
+            c.criterion,
+            material_label(c),
             particles,
             steps,
             o.wall,
@@ -203,23 +254,31 @@ pub fn table(outcomes: &[Outcome]) -> (String, String) {
             fmt_opt(err, 1),
             fmt_opt(o.paper(), 1),
             fmt_opt(perforation, 1),
-            fmt_opt(o.last_contact.map(|t| t * 1e6), 1),
+            paper_perforation,
+            fmt_opt(o.plug_mass(), 2),
+            fmt_opt(o.plug_speed(), 1),
+            fmt_opt(last_contact, 1),
         ));
         csv.push_str(&format!(
-            "{},{},{},{},{},{},{:.3},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{:.3},{},{},{},{},{},{},{},{},{},{}\n",
+            r.id,
             r.experiment.name,
-            r.geometry,
-            r.discretization,
-            r.criterion,
-            particles,
-            steps,
+            c.geometry,
+            c.discretization,
+            c.criterion,
+            material_label(c),
+            particles.replace('—', ""),
+            steps.replace('—', ""),
             o.wall,
-            fmt_opt(residual, 3),
+            fmt_csv(residual, 3),
             r.experiment.residual,
-            fmt_opt(err, 3),
-            fmt_opt(o.paper(), 1),
-            fmt_opt(perforation, 3),
-            fmt_opt(o.last_contact.map(|t| t * 1e6), 3),
+            fmt_csv(err, 3),
+            fmt_csv(o.paper(), 1),
+            fmt_csv(perforation, 3),
+            paper_perforation,
+            fmt_csv(o.plug_mass(), 4),
+            fmt_csv(o.plug_speed(), 3),
+            fmt_csv(last_contact, 3),
             status.replace(',', ";"),
         ));
     }
@@ -235,8 +294,10 @@ pub fn velocity_plot(outcomes: &[Outcome], experiment: &Experiment) -> LinePlot 
         .filter_map(|o| {
             let h = HistoryTable::read(&o.out_dir.join("history.csv")).ok()?;
             let (t, vx, vy) = (h.column("time")?, h.column("projectile_vx")?, h.column("projectile_vy")?);
+            let c = &o.row.case;
+            let material = if c.material == crate::cases::MATERIAL_MODIFIED { " modified" } else { "" };
             Some(Series {
-                name: format!("{} {} {}", o.row.geometry, o.row.discretization, o.row.criterion),
+                name: format!("{} {} {}{material}", c.geometry, c.discretization, c.criterion),
                 points: t.iter().zip(vx.iter().zip(vy)).map(|(t, (x, y))| (t * 1e6, (x * x + y * y).sqrt())).collect(),
             })
         })
@@ -255,29 +316,92 @@ pub fn velocity_plot(outcomes: &[Outcome], experiment: &Experiment) -> LinePlot 
     }
 }
 
+/// The field plots each row's run drew at \[RL10\]'s perforation time
+/// (`output.plot_times` of the case): `(row id, file)` relative to the
+/// validation directory, for the rows whose files exist.
+pub fn field_plots(outcomes: &[Outcome]) -> Vec<(String, String)> {
+    let mut v = Vec::new();
+    for o in outcomes.iter().filter(|o| o.result.is_ok()) {
+        let label = crate::output::time_label(o.row.experiment.perforation_time);
+        for field in ["effective_stress", "temperature"] {
+            let file = format!("{field}_{label}.png");
+            if o.out_dir.join(&file).exists() {
+                v.push((o.row.id.clone(), format!("{}/{file}", o.row.id)));
+            }
+        }
+    }
+    v
+}
+
+/// The Markdown report: `header` (provenance), how the columns are
+/// measured, the table, and the plots (`velocity_plots`: files relative to
+/// the validation directory).
+pub fn report(header: &str, outcomes: &[Outcome], velocity_plots: &[String]) -> String {
+    let (md, _) = table(outcomes);
+    let mut s = format!("{header}\n\n{md}\n{METHODS}\n\n");
+    for p in velocity_plots {
+        s.push_str(&format!("![projectile speed]({p})\n"));
+    }
+    let plots = field_plots(outcomes);
+    if !plots.is_empty() {
+        s.push_str(
+            "\nDeformed plate with its cracks at [RL10]'s perforation time, coloured by effective stress, \
+             and the temperature of the shear band at the projectile's corner:\n\n",
+        );
+        for (row, file) in plots {
+            s.push_str(&format!("![{row}]({file})\n"));
+        }
+    }
+    s
+}
+
+/// How the columns are measured (printed under the table).
+pub const METHODS: &str = "Residual velocity: the projectile's speed at the end of the run, once it \
+has flown free of contact (no slave particle pushing on it in `history.csv`) for at least 1 µs; \
+\"in contact at the end\" otherwise. Perforation: the first time the cracks cut a plug out of the \
+plate. Plug: the particles the through-cracks separate from the clamped plate (a flood fill over \
+the particles that the cracks do not separate), its mass (g; g per mm of depth in plane strain) \
+and mass-averaged velocity along the impact direction at the end of the run. [RL10]'s values \
+exist for its own model only (plane strain, its material).";
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn every_coarse_row_is_a_valid_case_of_its_experiment() {
-        let rows = coarse_rows();
-        assert_eq!(rows.len(), 8);
+    fn every_row_is_a_built_in_case_of_its_experiment() {
+        assert_eq!(coarse_rows().len(), 8);
+        let rows = all_rows();
+        assert_eq!(rows.len(), 20);
         for r in &rows {
-            let text = builtin_case(r.builtin).unwrap();
-            let case = Case::from_str_with(text, &r.id, &r.overrides).unwrap_or_else(|e| panic!("{}: {e}", r.id));
+            let text = builtin_case(&r.id).unwrap();
+            let case = Case::from_str_with(text, &r.id, &[]).unwrap_or_else(|e| panic!("{}: {e}", r.id));
             let plate = &case.bodies[0].rectangle;
             assert_eq!(plate.y_max - plate.y_min, r.experiment.thickness, "{}", r.id);
+            assert_eq!(plate.layers, if r.case.discretization == "coarse" { 24 } else { 48 }, "{}", r.id);
+            assert_eq!(case.bodies[0].material, r.case.material, "{}", r.id);
             let p = &case.rigid_bodies[0];
             assert_eq!(p.velocity[1], -r.experiment.impact_velocity);
             let nose = p.rectangle.as_ref().unwrap().center[1] - 0.04;
             assert!(nose > plate.y_max && nose - plate.y_max < 1e-4, "{}: nose {nose}", r.id);
-            assert_eq!(case.time.end, r.experiment.simulated_time);
+            assert_eq!(case.time.end, r.experiment.simulated_time, "{}", r.id);
+            assert_eq!(case.output.plot_times, vec![r.experiment.perforation_time], "{}", r.id);
             let fracture = toml::to_string(&case.fracture).unwrap();
-            assert!(fracture.contains(&format!("criterion = \"{}\"", r.criterion)), "{}: {fracture}", r.id);
+            assert!(fracture.contains(&format!("criterion = \"{}\"", r.case.criterion)), "{}: {fracture}", r.id);
             for s in &case.bodies[0].supports {
                 assert_eq!(s.region.y_max, r.experiment.thickness, "{}: support spans the thickness", r.id);
             }
         }
+    }
+
+    #[test]
+    fn only_selects_a_name_an_alias_or_every_name_containing_the_text() {
+        let ids = |v: Vec<Row>| v.into_iter().map(|r| r.id).collect::<Vec<_>>();
+        assert_eq!(ids(select(all_rows(), "borvik-1-axisymmetric")), ["borvik-1-axisymmetric"]);
+        assert_eq!(ids(select(all_rows(), "borvik-2")), ["borvik-2-plane-strain"]);
+        assert_eq!(select(all_rows(), "modified").len(), 4);
+        assert_eq!(select(all_rows(), "fine").len(), 12);
+        assert_eq!(select(coarse_rows(), "damage").len(), 4);
+        assert!(select(all_rows(), "nosuch").is_empty());
     }
 }

@@ -1,0 +1,213 @@
+//! The plug: the piece of a plate that the through-cracks have cut out under
+//! a projectile, with its mass and velocity (SPEC §10: besides the
+//! projectile's residual velocity, what an experimenter weighs and films).
+//!
+//! # Method
+//!
+//! The plug is found by a flood fill over the particles in the reference
+//! configuration, where the cracks are drawn (SPEC §9: the method is total
+//! Lagrangian). Two particles of the same body are *connected* when they are
+//! closer than [`LINK_FACTOR`] times the larger of their spacings (the eight
+//! lattice neighbours on a graded grid) and each is visible from the other
+//! under the crack visibility criterion ([`CrackVisibility`]: no extended
+//! crack segment crosses the line between them, and a split particle is seen
+//! only from its own side of the crack). The fill starts at the *seed*: the
+//! particle nearest the mid-thickness point of the impact line (the particle
+//! column under the projectile's centre, [`seed_particle`]). The component
+//! reached is the plug if it holds no supported particle (a clamp or roller;
+//! the axis condition of axisymmetry does not count) and less than half of
+//! its body's particles (for plates without supports). Otherwise the plate
+//! is not severed and there is no plug.
+//!
+//! Because crack paths run from surface to surface through the strip and
+//! every crack end that is not a growing tip is extended beyond the surface
+//! particle it was split at, a through-crack separates the strip exactly:
+//! any straight link between particles on its two sides crosses it. A crack
+//! whose tip still grows leaves a way around its tip, so an incompletely cut
+//! plate has no plug. The plug's mass is the sum of its particles' lumped
+//! masses (kg per metre of depth in plane strain, kg in axisymmetry), its
+//! velocity the mass-averaged generalized velocity `Σ m_I V_I / Σ m_I`, i.e.
+//! its momentum over its mass, which is what the lumped-mass dynamics
+//! conserves.
+
+use crate::fracture::{CrackGrowth, CrackVisibility};
+use crate::math::{Real, Vec2};
+use crate::model::Model;
+use crate::neighbors::CellGrid;
+use crate::particles::ParticleFlags;
+use crate::shape::Visibility;
+
+/// Particles closer than this many times the larger of their spacings are
+/// linked in the flood fill: above `√2` so that diagonal lattice neighbours
+/// of a graded grid (spacing ratio up to the growth factor) are linked,
+/// below 2 so that a link never jumps over a particle.
+pub const LINK_FACTOR: Real = 1.5;
+
+/// A plug cut out of a body.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Plug {
+    /// Its particles, ascending.
+    pub particles: Vec<usize>,
+    /// Mass, kg (per metre of depth in plane strain).
+    pub mass: Real,
+    /// Momentum `Σ m_I V_I`, kg m/s (per metre of depth in plane strain).
+    pub momentum: Vec2,
+}
+
+impl Plug {
+    /// The plug made of `particles`, with mass and momentum from `model`'s
+    /// current state.
+    pub fn of(model: &Model, particles: Vec<usize>) -> Self {
+        let p = &model.particles;
+        let mass = particles.iter().map(|&i| p.mass[i]).sum();
+        let momentum = particles.iter().fold(Vec2::zeros(), |acc, &i| acc + p.v[i] * p.mass[i]);
+        Plug { particles, mass, momentum }
+    }
+
+    /// Mass-averaged velocity, m/s.
+    pub fn velocity(&self) -> Vec2 {
+        if self.mass > 0.0 {
+            self.momentum / self.mass
+        } else {
+            Vec2::zeros()
+        }
+    }
+}
+
+/// The particle nearest the mid-thickness point of the impact line `x = axis_x`:
+/// among the particles of the column nearest the line (within one spacing of
+/// the nearest particle's distance), the one nearest the middle of that
+/// column's extent. `None` for an empty model.
+pub fn seed_particle(model: &Model, axis_x: Real) -> Option<usize> {
+    let p = &model.particles;
+    let nearest = (0..p.len()).map(|i| (p.x0[i].x - axis_x).abs()).fold(Real::INFINITY, Real::min);
+    if !nearest.is_finite() {
+        return None;
+    }
+    let column: Vec<usize> =
+        (0..p.len()).filter(|&i| (p.x0[i].x - axis_x).abs() <= nearest + 0.5 * p.spacing[i]).collect();
+    let (lo, hi) =
+        column.iter().fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), &i| (lo.min(p.x0[i].y), hi.max(p.x0[i].y)));
+    let middle = Vec2::new(axis_x, 0.5 * (lo + hi));
+    column.into_iter().min_by(|&a, &b| {
+        let (da, db) = ((p.x0[a] - middle).norm(), (p.x0[b] - middle).norm());
+        da.partial_cmp(&db).expect("finite positions").then(a.cmp(&b))
+    })
+}
+
+/// Whether particle `i` is held by a support (a clamp or a roller; the
+/// radial condition on the axis of axisymmetry does not hold a plug).
+fn supported(flags: ParticleFlags) -> bool {
+    flags.has(ParticleFlags::FIX_Y) || (flags.has(ParticleFlags::FIX_X) && !flags.has(ParticleFlags::ON_AXIS))
+}
+
+/// The particles of the piece cut out around the seed particle under the
+/// impact line `x = axis_x` (module doc), or `None` if the cracks do not
+/// sever it from the supports (or there are no arrested cracks at all).
+pub fn plug_particles(model: &Model, cracks: &CrackGrowth, axis_x: Real) -> Option<Vec<usize>> {
+    if !cracks.cracks.iter().any(|c| c.arrested.is_some()) {
+        return None;
+    }
+    let seed = seed_particle(model, axis_x)?;
+    let p = &model.particles;
+    let body = p.body[seed];
+    let body_count = p.body.iter().filter(|&&b| b == body).count();
+    let h_max = p.spacing.iter().cloned().fold(0.0, Real::max);
+    let reach = LINK_FACTOR * h_max;
+    if !(reach > 0.0 && reach.is_finite()) {
+        return None;
+    }
+    let grid = CellGrid::new(&p.x0, reach);
+    let vis: CrackVisibility = cracks.visibility(model);
+    let mut seen = vec![false; p.len()];
+    let mut stack = vec![seed];
+    let mut piece = Vec::new();
+    seen[seed] = true;
+    while let Some(i) = stack.pop() {
+        if supported(p.flags[i]) || 2 * (piece.len() + 1) > body_count {
+            return None;
+        }
+        piece.push(i);
+        let xi = p.x0[i];
+        grid.for_each_candidate(&xi, reach, |j| {
+            if seen[j] || p.body[j] != body {
+                return;
+            }
+            let xj = p.x0[j];
+            if (xj - xi).norm() > LINK_FACTOR * p.spacing[i].max(p.spacing[j]) {
+                return;
+            }
+            if vis.visible(&xi, j) && vis.visible(&xj, i) {
+                seen[j] = true;
+                stack.push(j);
+            }
+        });
+    }
+    piece.sort_unstable();
+    Some(piece)
+}
+
+/// The plug under the impact line `x = axis_x` with its current mass and
+/// momentum, if the cracks have cut one out.
+pub fn find_plug(model: &Model, cracks: &CrackGrowth, axis_x: Real) -> Option<Plug> {
+    plug_particles(model, cracks, axis_x).map(|particles| Plug::of(model, particles))
+}
+
+/// Follows the plug through a run at low cost: the flood fill runs again
+/// only when the crack set or the particle count has changed since the last
+/// call (cracks only grow, so between changes the plug keeps its
+/// particles); in between, only its mass and momentum are summed. Refreshed
+/// after every step, it also knows when the plug was first cut out (the
+/// perforation time).
+#[derive(Clone, Debug, Default)]
+pub struct PlugTracker {
+    /// Crack events and particles at the last flood fill.
+    seen: Option<(usize, usize)>,
+    particles: Option<Vec<usize>>,
+    /// Time of the first state in which a plug was found, s.
+    pub first_cut: Option<Real>,
+}
+
+impl PlugTracker {
+    /// A tracker that continues a run in which the plug was first cut out
+    /// at `first_cut` (a resumed run).
+    pub fn continuing(first_cut: Option<Real>) -> Self {
+        PlugTracker { first_cut, ..Default::default() }
+    }
+
+    /// Bring the plug's particles up to date with the state at `time`
+    /// (a flood fill only if the cracks or the particles changed).
+    pub fn refresh(&mut self, model: &Model, cracks: &CrackGrowth, axis_x: Real, time: Real) {
+        let now = (cracks.events.len(), model.particles.len());
+        if self.seen != Some(now) {
+            self.particles = plug_particles(model, cracks, axis_x);
+            self.seen = Some(now);
+            if self.particles.is_some() && self.first_cut.is_none() {
+                self.first_cut = Some(time);
+            }
+        }
+    }
+
+    /// The plug in the state at `time`, if any (see [`find_plug`]).
+    pub fn update(&mut self, model: &Model, cracks: &CrackGrowth, axis_x: Real, time: Real) -> Option<Plug> {
+        self.refresh(model, cracks, axis_x, time);
+        self.particles.as_ref().map(|ids| Plug::of(model, ids.clone()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn axis_support_does_not_hold_a_plug_but_a_clamp_does() {
+        let mut f = ParticleFlags::default();
+        f.set(ParticleFlags::ON_AXIS | ParticleFlags::FIX_X);
+        assert!(!supported(f));
+        f.set(ParticleFlags::FIX_Y);
+        assert!(supported(f));
+        let mut roller = ParticleFlags::default();
+        roller.set(ParticleFlags::FIX_X);
+        assert!(supported(roller));
+    }
+}
