@@ -227,6 +227,11 @@ pub struct TimeSpec {
     /// A fixed step, s, overriding the CFL rule (\[RL10\] used 4e-9 s).
     #[serde(default)]
     pub fixed_dt: Option<Real>,
+    /// Stop early, s: once a plug has been cut out and the first rigid
+    /// body has had no contact for this long, the run ends there instead of
+    /// at `end` (its speed no longer changes). Default: run to `end`.
+    #[serde(default)]
+    pub stop_after_release: Option<Real>,
 }
 
 fn half() -> Real {
@@ -553,6 +558,9 @@ impl Case {
         positive(&mut add, "time.end", self.time.end, "s");
         if !(self.time.safety_factor > 0.0 && self.time.safety_factor <= 1.0) {
             add("time.safety_factor".into(), format!("must lie in (0, 1], got {}", self.time.safety_factor));
+        }
+        if let Some(t) = self.time.stop_after_release {
+            positive(&mut add, "time.stop_after_release", t, "s");
         }
         if let Some(dt) = self.time.fixed_dt {
             positive(&mut add, "time.fixed_dt", dt, "s");

@@ -71,6 +71,10 @@ enum Command {
         /// (e.g. borvik-2, damage, fine); chosen among all rows.
         #[arg(long)]
         only: Option<String>,
+        /// Run every row to the paper's simulated time (118 or 216 us) instead
+        /// of stopping 20 us after the projectile's release.
+        #[arg(long)]
+        full_time: bool,
     },
     /// Benchmark fixed workloads: shape functions, material kernel, force
     /// assembly, whole steps (1 and all threads), optionally whole cases.
@@ -181,7 +185,7 @@ fn dispatch(cmd: Command) -> Result<()> {
             Ok(())
         }
         Command::Bench { case, steps, whole, set } => bench(&case, steps, whole, &set),
-        Command::Validate { out, all, only } => validate(&out, all, only.as_deref()),
+        Command::Validate { out, all, only, full_time } => validate(&out, all, only.as_deref(), full_time),
         Command::MaterialPoint { material, case_file, path, rate, strain, dt, out } => {
             material_point(&material, case_file.as_deref(), path, rate, strain, dt, &out)
         }
@@ -279,7 +283,7 @@ fn material_point(
     Ok(())
 }
 
-fn validate(out: &Path, all: bool, only: Option<&str>) -> Result<()> {
+fn validate(out: &Path, all: bool, only: Option<&str>, full_time: bool) -> Result<()> {
     use plugsim::validation::{all_rows, coarse_rows, report, run_row, select, table, velocity_plot, EXPERIMENTS};
     let rows = match only {
         Some(o) => select(all_rows(), o),
@@ -294,7 +298,7 @@ fn validate(out: &Path, all: bool, only: Option<&str>) -> Result<()> {
     let mut outcomes = Vec::new();
     for (k, row) in rows.iter().enumerate() {
         eprintln!("  [{}/{}] {} ...", k + 1, rows.len(), row.id);
-        let o = run_row(row, out);
+        let o = run_row(row, out, full_time);
         eprintln!(
             "        {:.1} s{}",
             o.wall,

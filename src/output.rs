@@ -71,6 +71,8 @@ pub struct OutputWriter {
     crack_events_written: usize,
     /// The plug, followed from step to step.
     plug: crate::plug::PlugTracker,
+    /// Time of the last step with contacts on the first rigid body, s.
+    last_contact: Option<Real>,
     /// Step of the last history row (a step gets at most one).
     last_row_step: Option<u64>,
 }
@@ -89,6 +91,7 @@ impl OutputWriter {
             crack_log: None,
             crack_events_written: 0,
             plug: Default::default(),
+            last_contact: None,
             last_row_step: None,
         })
     }
@@ -150,6 +153,7 @@ impl OutputWriter {
             crack_log: None,
             crack_events_written: 0,
             plug: crate::plug::PlugTracker::continuing(first_cut),
+            last_contact: None,
             last_row_step,
         };
         let log = dir.join("cracks.csv");
@@ -265,6 +269,19 @@ impl OutputWriter {
             }
         }
         Ok(())
+    }
+
+    /// How long the first rigid body has been free of contact since a plug
+    /// was cut out, s (`None` before the plug, while in contact, or if it
+    /// never touched). Call after every step (`time.stop_after_release`).
+    pub fn released_for(&mut self, sim: &Simulation) -> Option<Real> {
+        let contacts = sim.contact.as_ref().and_then(|c| c.sample(0)).map(|s| s.active_contacts)?;
+        if contacts > 0 {
+            self.last_contact = Some(sim.time);
+        }
+        self.plug.first_cut?;
+        let free = sim.time - self.last_contact?;
+        (free > 0.0).then_some(free)
     }
 
     /// Append the events of `cracks` not yet written to `cracks.csv`.

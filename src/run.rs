@@ -383,8 +383,9 @@ fn time_loop(
     let mut plot_times: Vec<Real> =
         case.output.plot_times.iter().cloned().filter(|&t| !outputs_done || t - 0.5 * sim.dt > sim.time).collect();
     plot_times.sort_by(|a, b| b.total_cmp(a));
+    let mut released = false;
     loop {
-        let done = sim.time >= end - 0.5 * sim.dt;
+        let done = released || sim.time >= end - 0.5 * sim.dt;
         if !outputs_done {
             if sim.time >= schedule.next_snapshot - 0.5 * sim.dt || done {
                 let t = Instant::now();
@@ -440,6 +441,9 @@ fn time_loop(
             let last = out.snapshot(&sim)?;
             out.history_row(&sim)?;
             return Err(RunError::Unstable { error, last_snapshot: last, dir: cfg.out_dir.clone() });
+        }
+        if let Some(wait) = case.time.stop_after_release {
+            released = out.released_for(&sim).is_some_and(|free| free >= wait);
         }
         if sim.step.is_multiple_of(report_every) {
             progress(Progress::Step { sim: &sim });
