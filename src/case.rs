@@ -228,8 +228,9 @@ pub struct TimeSpec {
     #[serde(default)]
     pub fixed_dt: Option<Real>,
     /// Stop early, s: once a plug has been cut out and the first rigid
-    /// body has had no contact for this long, the run ends there instead of
-    /// at `end` (its speed no longer changes). Default: run to `end`.
+    /// body has had no contact, both for this long, the run ends there
+    /// instead of at `end` (its speed no longer changes). Default: run to
+    /// `end`.
     #[serde(default)]
     pub stop_after_release: Option<Real>,
 }

@@ -271,16 +271,16 @@ impl OutputWriter {
         Ok(())
     }
 
-    /// How long the first rigid body has been free of contact since a plug
-    /// was cut out, s (`None` before the plug, while in contact, or if it
+    /// How long the first rigid body has been free of contact and the plug
+    /// cut out (time since the later of the two), s (`None` before the plug, while in contact, or if it
     /// never touched). Call after every step (`time.stop_after_release`).
     pub fn released_for(&mut self, sim: &Simulation) -> Option<Real> {
         let contacts = sim.contact.as_ref().and_then(|c| c.sample(0)).map(|s| s.active_contacts)?;
         if contacts > 0 {
             self.last_contact = Some(sim.time);
         }
-        self.plug.first_cut?;
-        let free = sim.time - self.last_contact?;
+        let cut = self.plug.first_cut?;
+        let free = sim.time - self.last_contact?.max(cut);
         (free > 0.0).then_some(free)
     }
 

@@ -600,3 +600,29 @@ fn fracture_section_is_validated() {
         Case::from_str_with(text, "f.toml", &["fracture.criterion=\"stress\"".to_string()]).unwrap_err().to_string();
     assert!(bad.contains("stress"), "{bad}");
 }
+
+/// `time.stop_after_release`: a run that perforates ends once the
+/// projectile has been free of contact for that long, not at `time.end`;
+/// without a plug it runs to the end.
+#[test]
+fn run_stops_after_the_projectile_is_released() {
+    use plugsim::run::{execute, RunConfig, RunInfo};
+    let dir = std::env::temp_dir().join(format!("plugsim-release-{}", std::process::id()));
+    let wait = 1.0e-6;
+    let set =
+        ["time.end=4e-5".to_string(), format!("time.stop_after_release={wait}"), "output.interval=1e-5".to_string()];
+    let case = Case::from_str_with(SMALL_IMPACT, "small", &set).unwrap().resolved();
+    let cfg = RunConfig::new(dir.clone(), true, RunInfo::current("test", &[]));
+    let s = execute(&case, &cfg, &mut |_| {}).unwrap();
+    let perforated = s.perforation.expect("the small plate is perforated");
+    let last = s.last_contacts[0].1.expect("the projectile touched the plate");
+    assert!(s.time < 4e-5, "stopped early: {} s", s.time);
+    // the wait counts from the later of perforation and the last contact
+    // (the history's last contact row is within a history interval of it)
+    let from = last.max(perforated);
+    assert!(s.time >= from + wait && s.time <= from + wait + 20.0 * s.dt, "{} {last} {perforated}", s.time);
+    // a negative wait is rejected, naming the field
+    let bad = Case::from_str_with(SMALL_IMPACT, "small", &["time.stop_after_release=-1e-6".to_string()]);
+    assert!(bad.is_err_and(|e| e.to_string().contains("time.stop_after_release")));
+    std::fs::remove_dir_all(&dir).ok();
+}
