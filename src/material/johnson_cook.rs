@@ -256,6 +256,29 @@ pub struct PlasticRate {
     pub d_rate_d_tau: Real,
 }
 
+/// The factors of the flow stress at one state (see
+/// [`JohnsonCook::flow_stress`]): `g = (A + B ε̄ⁿ) · thermal · dmg`.
+#[derive(Clone, Copy, Debug)]
+struct FlowFactors {
+    /// `max(ε̄, 0)`.
+    eps: Real,
+    /// `ε̄ⁿ`.
+    eps_n: Real,
+    /// `A + B ε̄ⁿ`, Pa.
+    strain_part: Real,
+    /// `1 − T*ᵐ` (Deviation 3).
+    thermal: Real,
+    /// `1 − D` with damage coupling, else 1.
+    dmg: Real,
+}
+
+impl FlowFactors {
+    #[inline]
+    fn g(&self) -> Real {
+        self.strain_part * self.thermal * self.dmg
+    }
+}
+
 /// A parameter outside its admissible range.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error("Johnson-Cook parameter `{parameter}` = {value} must be {requirement}")]
@@ -367,8 +390,7 @@ impl JohnsonCook {
     /// `g = (A + B ε̄ⁿ)(1 − T*ᵐ)` (× `(1 − D)` with damage coupling), Pa.
     /// SPEC §6, [RL10, Eqs. (2.46)–(2.72)].
     pub fn flow_stress(&self, eps_p: Real, temperature: Real, damage: Real) -> Real {
-        let strain = self.yield_stress + self.hardening_modulus * eps_p.max(0.0).powf(self.hardening_exponent);
-        strain * self.thermal_factor(temperature) * self.damage_factor(damage)
+        self.flow_factors(eps_p, temperature, damage).g()
     }
 
     /// `g` with its partial derivatives
@@ -378,24 +400,44 @@ impl JohnsonCook {
     /// coupling. SPEC §6, [RL10, Eqs. (2.46)–(2.72)]. Regularised by
     /// Deviations 1–3.
     pub fn flow_stress_slopes(&self, eps_p: Real, temperature: Real, damage: Real) -> FlowStress {
-        let n = self.hardening_exponent;
-        let m = self.softening_exponent;
+        self.slopes_from(&self.flow_factors(eps_p, temperature, damage), temperature)
+    }
+
+    /// The factors of `g` at one state. A step evaluates each power once and
+    /// shares it between `g` and its slopes (the same operations, in the same
+    /// order, as evaluating each on its own).
+    fn flow_factors(&self, eps_p: Real, temperature: Real, damage: Real) -> FlowFactors {
+        self.hardening_factors(eps_p, self.thermal_factor(temperature), self.damage_factor(damage))
+    }
+
+    /// [`FlowFactors`] at plastic strain `eps_p` with the thermal and damage
+    /// factors given (the radial return varies `ε̄` only).
+    fn hardening_factors(&self, eps_p: Real, thermal: Real, dmg: Real) -> FlowFactors {
         let eps = eps_p.max(0.0);
-        let eps_n = eps.powf(n);
-        let strain_part = self.yield_stress + self.hardening_modulus * eps_n;
-        let thermal = self.thermal_factor(temperature);
-        let dmg = self.damage_factor(damage);
+        let eps_n = eps.powf(self.hardening_exponent);
+        FlowFactors { eps, eps_n, strain_part: self.yield_stress + self.hardening_modulus * eps_n, thermal, dmg }
+    }
+
+    /// `g_ε = B n ε̄ⁿ⁻¹ (1 − T*ᵐ)(1 − D)`, regularised by Deviation 1.
+    fn hardening_slope(&self, f: &FlowFactors) -> Real {
+        let n = self.hardening_exponent;
         // ε̄ⁿ⁻¹ = ε̄ⁿ/ε̄ above the floor: one power instead of two.
-        let eps_n_minus_1 = if eps >= PLASTIC_STRAIN_FLOOR { eps_n / eps } else { PLASTIC_STRAIN_FLOOR.powf(n - 1.0) };
-        let g_eps = self.hardening_modulus * n * eps_n_minus_1 * thermal * dmg;
+        let eps_n_minus_1 =
+            if f.eps >= PLASTIC_STRAIN_FLOOR { f.eps_n / f.eps } else { PLASTIC_STRAIN_FLOOR.powf(n - 1.0) };
+        self.hardening_modulus * n * eps_n_minus_1 * f.thermal * f.dmg
+    }
+
+    /// [`JohnsonCook::flow_stress_slopes`] from the factors at `temperature`.
+    fn slopes_from(&self, f: &FlowFactors, temperature: Real) -> FlowStress {
+        let m = self.softening_exponent;
         let t_star = self.homologous_temperature(temperature);
         let g_temp = if !(0.0..1.0).contains(&t_star) {
             0.0
         } else {
-            -m * t_star.max(HOMOLOGOUS_TEMPERATURE_FLOOR).powf(m - 1.0) * strain_part * dmg
+            -m * t_star.max(HOMOLOGOUS_TEMPERATURE_FLOOR).powf(m - 1.0) * f.strain_part * f.dmg
                 / (self.melting_temperature - self.room_temperature)
         };
-        FlowStress { g: strain_part * thermal * dmg, g_eps, g_temp }
+        FlowStress { g: f.g(), g_eps: self.hardening_slope(f), g_temp }
     }
 
     /// The rate factor `τ̄/g` of steady flow at plastic rate `rate`: `1 + C ln(ε̄̇/ε̇₀)`
@@ -682,13 +724,15 @@ impl JohnsonCook {
         // bracket's current end, bisection whenever it would leave the
         // bracket or stall. Derivative: dr/dτ̄_e = Δt (f_τ + f_τ τ̄_e g_ε /
         // (3G g)) + 1/(3G), using ∂φ/∂g = −f_τ τ̄_e/g (both rate laws).
+        // Temperature and damage are frozen: their factors are evaluated once.
+        let (thermal, dmg) = (self.thermal_factor(old.temperature), self.damage_factor(old.damage));
         let residual = |tau_e: Real| {
             let d_eps = (tau_trial - tau_e) / three_g;
-            let slopes = self.flow_stress_slopes(old.eps_p + d_eps, old.temperature, old.damage);
-            let g = slopes.g.max(fs.g);
+            let f = self.hardening_factors(old.eps_p + d_eps, thermal, dmg);
+            let g = f.g().max(fs.g);
             let pr = self.plastic_rate(tau_e, g);
             let r = dt * pr.rate - d_eps;
-            let dr = dt * pr.d_rate_d_tau * (1.0 + tau_e * slopes.g_eps / (three_g * g)) + 1.0 / three_g;
+            let dr = dt * pr.d_rate_d_tau * (1.0 + tau_e * self.hardening_slope(&f) / (three_g * g)) + 1.0 / three_g;
             (r, dr)
         };
         // rtsafe-style: Newton while it stays inside the bracket and halves
@@ -745,7 +789,8 @@ impl Constitutive for JohnsonCook {
     /// direction is not resolved (Deviation 11), else the tangent-modulus
     /// update.
     fn update(&self, old: &PointState, k: &StepKinematics) -> PointState {
-        let g = self.flow_stress(old.eps_p, old.temperature, old.damage);
+        let factors = self.flow_factors(old.eps_p, old.temperature, old.damage);
+        let g = factors.g();
         if self.is_strengthless(g) {
             return self.update_strengthless(old, k);
         }
@@ -755,7 +800,7 @@ impl Constitutive for JohnsonCook {
                 return elastic_step;
             }
         }
-        let fs = self.flow_stress_slopes(old.eps_p, old.temperature, old.damage);
+        let fs = self.slopes_from(&factors, old.temperature);
         if self.rate_form == RateForm::Power && tau_bar < fs.g {
             return self.update_power_below_flow_stress(old, k, &fs);
         }
