@@ -30,6 +30,14 @@ impl GeometryMode {
         }
     }
 
+    /// Whether [`Self::deformation_gradient`] reads the interpolated
+    /// displacement `u` (the hoop stretch `u_r/R` of axisymmetry); in plane
+    /// strain only the gradient is needed.
+    #[inline]
+    pub fn needs_point_values(self) -> bool {
+        self == GeometryMode::Axisymmetric
+    }
+
     /// Deformation gradient from the in-plane displacement gradient
     /// `grad_u[i][J] = ∂u_i/∂X_J` and the interpolated displacement `u` at
     /// reference point `x0` (SPEC §2). Also used with velocities to get `Ḟ`

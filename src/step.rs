@@ -4,11 +4,10 @@
 use crate::contact::{ContactError, ContactSystem, StepInput};
 use crate::fracture::{CrackGrowth, FractureError};
 use crate::material::{Constitutive, StepKinematics};
-use crate::math::{ddot, skew, sym, Real, Tensor3, Vec2};
+use crate::math::{ddot, determinant_2d, mul_2d, skew, sym, try_inverse_2d, Real, Tensor3, Vec2};
 use crate::model::{constrain, Model};
 use crate::particles::ParticleFlags;
 use crate::thermal::{HeatConduction, HeatError};
-use nalgebra::Matrix2;
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
 
@@ -414,32 +413,29 @@ impl Simulation {
             .into_par_iter()
             .enumerate()
             .map(|(qi, (f, tau, eps_p, eps_rate, temp, dmg, pw, work, x0, w, body))| {
-                // Legend: gu = grad U, gv = grad V (2x2), uq/vq = interpolated U, V.
-                let mut gu = Matrix2::<Real>::zeros();
-                let mut gv = Matrix2::<Real>::zeros();
-                let (mut uq, mut vq) = (Vec2::zeros(), Vec2::zeros());
-                for k in tab.range(qi) {
-                    let i = tab.index[k] as usize;
-                    let (n, g) = (tab.value[k], tab.grad[k]);
-                    gu += u[i] * g.transpose();
-                    gv += v[i] * g.transpose();
-                    uq += u[i] * n;
-                    vq += v[i] * n;
-                }
+                // Legend: gu = grad U, gv = grad V (2x2), uq/vq = interpolated U, V
+                // (only read in axisymmetry). The 3x3 algebra uses the block
+                // form of 2D kinematics (same bits as the general products).
+                let (gu, gv) = tab.gradient_pair(qi, u, v);
+                let (uq, vq) = if mode.needs_point_values() {
+                    (tab.interpolate(qi, u), tab.interpolate(qi, v))
+                } else {
+                    (Vec2::zeros(), Vec2::zeros())
+                };
                 let F_new = mode.deformation_gradient(&gu, &uq, x0, 1.0);
                 let F_dot = mode.deformation_gradient(&gv, &vq, x0, 0.0);
                 let F_mid = (*f + F_new) * 0.5;
-                let J = F_new.determinant();
-                let Some(F_mid_inv) = F_mid.try_inverse() else {
+                let J = determinant_2d(&F_new);
+                let Some(F_mid_inv) = try_inverse_2d(&F_mid) else {
                     return Some((qi, J));
                 };
-                let Some(F_inv) = F_new.try_inverse() else {
+                let Some(F_inv) = try_inverse_2d(&F_new) else {
                     return Some((qi, J));
                 };
                 if J <= 0.0 || !J.is_finite() {
                     return Some((qi, J));
                 }
-                let l = F_dot * F_mid_inv;
+                let l = mul_2d(&F_dot, &F_mid_inv);
                 let kin = StepKinematics { d: sym(&l), w: skew(&l), dt };
                 let old = crate::material::PointState {
                     tau: *tau,
@@ -457,7 +453,7 @@ impl Simulation {
                 *eps_rate = new.eps_p_rate;
                 *temp = new.temperature;
                 *dmg = new.damage;
-                *pw = new.tau * F_inv.transpose() * *w;
+                *pw = mul_2d(&new.tau, &F_inv.transpose()) * *w;
                 None
             })
             .find_first(|r| r.is_some())

@@ -1,6 +1,7 @@
 //! Compressed-row storage of shape-function values and gradients.
 
 use crate::math::{Real, Vec2};
+use nalgebra::Matrix2;
 
 /// Shape functions `N_I(X_p)` and gradients `∇_X N_I(X_p)` of a set of
 /// evaluation points `p` (quadrature points, or particles themselves), one
@@ -42,5 +43,22 @@ impl ShapeTable {
             s += field[self.index[k] as usize] * self.value[k];
         }
         s
+    }
+
+    /// Gradients of two particle fields at evaluation point `p`:
+    /// `(Σ_I a_I ⊗ ∇N_I(X_p), Σ_I b_I ⊗ ∇N_I(X_p))`, entries in row order.
+    /// The velocity-gradient sweep of every step: one pass over the row's
+    /// indices and gradients, without the values.
+    #[inline]
+    pub fn gradient_pair(&self, p: usize, a: &[Vec2], b: &[Vec2]) -> (Matrix2<Real>, Matrix2<Real>) {
+        let r = self.range(p);
+        let (index, grad) = (&self.index[r.clone()], &self.grad[r]);
+        let (mut ga, mut gb) = (Matrix2::zeros(), Matrix2::zeros());
+        for (&i, g) in index.iter().zip(grad) {
+            let i = i as usize;
+            ga += a[i] * g.transpose();
+            gb += b[i] * g.transpose();
+        }
+        (ga, gb)
     }
 }
