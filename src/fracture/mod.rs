@@ -29,7 +29,7 @@
 //! its centre line.
 //!
 //! # Deviations and choices (tests in `tests/fracture.rs` unless named)
-//! - Nucleation ([RL10]: "the first slave particle that meets the
+//! - Nucleation (\[RL10\]: "the first slave particle that meets the
 //!   criterion"): of the slave particles meeting the criterion in a step,
 //!   in decreasing order of value, each becomes a core unless it lies on a
 //!   crack face or within `nucleation_distance_factor × h` of an existing
@@ -69,13 +69,13 @@
 //! - Arrest is tested **before** propagation: a tip whose circle of radius
 //!   `R` holds an empty sector wider than `θ_c` around its direction of
 //!   growth is on the outer surface and stops, even if a surface neighbour
-//!   inside the fan meets the criterion ([RL10]'s order — propagate if a
+//!   inside the fan meets the criterion (\[RL10\]'s order — propagate if a
 //!   candidate exists — would let an oblique crack run along the far
-//!   surface). We read [RL10]'s `θ_max − θ_min > θ_c` as the width of that
+//!   surface). We read \[RL10\]'s `θ_max − θ_min > θ_c` as the width of that
 //!   empty sector between consecutive particle directions
 //!   (`arrest_at_the_far_surface_without_running_along_it`).
 //! - The fan is applied twice: candidates lie within `θ_c/2` of the last
-//!   segment's direction ([RL10]) **and** of the crack's mean direction
+//!   segment's direction (\[RL10\]) **and** of the crack's mean direction
 //!   (nucleation point to tip). With the last segment alone a crack can
 //!   turn by up to `θ_c/2` per step and so U-turn in three steps; in the
 //!   Borvik plane-strain case both cracks did, ~7 rows down, hunting back
