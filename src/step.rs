@@ -302,6 +302,9 @@ impl Simulation {
             for i in faces {
                 contact.slaves.add(i);
             }
+            // The new particles carry no contact force this step; the column
+            // keeps one entry per particle (a checkpoint written now checks it).
+            self.f_contact.resize(self.model.particles.len(), Vec2::zeros());
         }
         self.internal_force();
         Ok(())

@@ -263,7 +263,7 @@ const FRACTURE_SETS: &[&str] = &[
     "time.end=8e-6",
     "output.interval=1e-6",
     "output.history_every=5",
-    "checkpoint.interval=4e-6",
+    "checkpoint.interval=4.7e-6",
 ];
 const FRACTURE_STOP: u64 = 30;
 
