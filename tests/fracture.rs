@@ -4,9 +4,10 @@
 //! The invariants (mass, momentum, reproduction, no support across a crack)
 //! are checked after every split with their own code, not the solver's.
 
+mod common;
+
 use plugsim::case::Case;
 use plugsim::contact::{SlaveSet, SurfaceDetection};
-use plugsim::discretize::RectangleGrid;
 use plugsim::fracture::growth::nodal_mass;
 use plugsim::fracture::rows::Basis;
 use plugsim::fracture::{CrackGrowth, Criterion, EventKind, FractureParameters};
@@ -33,20 +34,7 @@ fn plate(nx: usize, ny: usize) -> Model {
 
 /// [`plate`] in either geometry mode (in axisymmetry, x = 0 is the axis).
 fn plate_in(mode: GeometryMode, nx: usize, ny: usize) -> Model {
-    let grid = RectangleGrid {
-        x_min: 0.0,
-        x_max: (nx - 1) as Real * H,
-        y_min: 0.0,
-        y_max: (ny - 1) as Real * H,
-        layers: ny,
-        refine_at: Some(0.0),
-        fine_half_width: 0.0,
-        fine_spacing: None,
-        growth: 1.0,
-        coarse_spacing: None,
-        support_factor: 2.0,
-        gauss: 2,
-    };
+    let grid = common::uniform_lattice(nx, ny, H);
     let body = BodySetup {
         name: "plate".into(),
         grid,

@@ -3,8 +3,9 @@
 //! lattices with inserted cracks, against the particles known to lie
 //! between them.
 
+mod common;
+
 use plugsim::contact::{SlaveSet, SurfaceDetection};
-use plugsim::discretize::RectangleGrid;
 use plugsim::fracture::{CrackGrowth, Criterion, FractureParameters};
 use plugsim::geometry::GeometryMode;
 use plugsim::material::{Elastic, Material};
@@ -24,20 +25,7 @@ fn steel() -> Elastic {
 /// last two columns (and, in plane strain, its first two).
 fn plate(mode: GeometryMode) -> Model {
     let (w, t) = ((NX - 1) as Real * H, (NY - 1) as Real * H);
-    let grid = RectangleGrid {
-        x_min: 0.0,
-        x_max: w,
-        y_min: 0.0,
-        y_max: t,
-        layers: NY,
-        refine_at: Some(0.0),
-        fine_half_width: 0.0,
-        fine_spacing: None,
-        growth: 1.0,
-        coarse_spacing: None,
-        support_factor: 2.0,
-        gauss: 2,
-    };
+    let grid = common::uniform_lattice(NX, NY, H);
     let clamp =
         |x_min: Real, x_max: Real| Support { region: Region { x_min, x_max, y_min: 0.0, y_max: t }, fix: Fix::All };
     let mut supports = vec![clamp(w - 1.5 * H, w)];

@@ -1,10 +1,34 @@
 //! Helpers shared by the integration tests.
 
 use plugsim::case::Case;
+use plugsim::discretize::RectangleGrid;
+use plugsim::math::Real;
+
+/// A uniform lattice of `nx × ny` particles of spacing `h` on
+/// `[0, (nx−1)h] × [0, (ny−1)h]`, finest (uniform) from x = 0, support
+/// factor 2, 2×2 Gauss points.
+#[allow(dead_code)] // not every test binary uses every helper
+pub fn uniform_lattice(nx: usize, ny: usize, h: Real) -> RectangleGrid {
+    RectangleGrid {
+        x_min: 0.0,
+        x_max: (nx - 1) as Real * h,
+        y_min: 0.0,
+        y_max: (ny - 1) as Real * h,
+        layers: ny,
+        refine_at: Some(0.0),
+        fine_half_width: 0.0,
+        fine_spacing: None,
+        growth: 1.0,
+        coarse_spacing: None,
+        support_factor: 2.0,
+        gauss: 2,
+    }
+}
 
 /// Borvik Case I without fracture on a narrower (60 mm), coarser (10-row)
 /// plate, clamped at both ends as the real case: the same physics, fast
 /// enough for a test. `extra` overrides are applied after these.
+#[allow(dead_code)] // not every test binary uses every helper
 pub fn small_borvik_nofracture(extra: &[&str]) -> Case {
     let text = include_str!("../../cases/borvik-1-nofracture.toml");
     let set: Vec<String> = [
