@@ -317,14 +317,7 @@ fn validate(out: &Path, all: bool, only: Option<&str>, full_time: bool) -> Resul
         }
     }
     let commit = env!("PLUGSIM_COMMIT");
-    let cpu = std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("model name"))
-                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
-        })
-        .unwrap_or_else(|| "unknown CPU".into());
+    let cpu = cpu_name();
     let header = format!(
         "Produced by `plugsim validate` ({} {commit}) on {cpu}, {} threads.",
         env!("CARGO_PKG_VERSION"),
@@ -338,19 +331,25 @@ fn validate(out: &Path, all: bool, only: Option<&str>, full_time: bool) -> Resul
     Ok(())
 }
 
-fn bench(name: &str, steps: usize, whole: Option<f64>, set: &[String]) -> Result<()> {
-    use plugsim::bench;
-    let text = builtin_case(name).with_context(|| format!("unknown built-in case '{name}'"))?;
-    let case = Case::from_str_with(text, name, set)?.resolved();
-    let all = rayon::current_num_threads();
-    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+/// The CPU's model name from `/proc/cpuinfo`, for the provenance lines of
+/// `validate` and `bench`.
+fn cpu_name() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|s| {
             s.lines()
                 .find(|l| l.starts_with("model name"))
                 .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
         })
-        .unwrap_or_else(|| "unknown CPU".into());
+        .unwrap_or_else(|| "unknown CPU".into())
+}
+
+fn bench(name: &str, steps: usize, whole: Option<f64>, set: &[String]) -> Result<()> {
+    use plugsim::bench;
+    let text = builtin_case(name).with_context(|| format!("unknown built-in case '{name}'"))?;
+    let case = Case::from_str_with(text, name, set)?.resolved();
+    let all = rayon::current_num_threads();
+    let cpu = cpu_name();
     println!(
         "plugsim bench {} ({}) on {cpu}, {all} threads available",
         env!("CARGO_PKG_VERSION"),
