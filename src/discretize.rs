@@ -86,6 +86,26 @@ pub struct GeneratedBody {
 }
 
 impl RectangleGrid {
+    /// A uniform lattice of spacing `h` on `[x.0, x.1] × [y.0, y.1]` (the
+    /// extents multiples of `h`): no grading, support factor 2, 2×2 Gauss
+    /// points. For tests and small examples.
+    pub fn uniform(x: (Real, Real), y: (Real, Real), h: Real) -> Self {
+        RectangleGrid {
+            x_min: x.0,
+            x_max: x.1,
+            y_min: y.0,
+            y_max: y.1,
+            layers: ((y.1 - y.0) / h).round() as usize + 1,
+            refine_at: None,
+            fine_half_width: 0.0,
+            fine_spacing: Some(h),
+            growth: 1.0,
+            coarse_spacing: None,
+            support_factor: 2.0,
+            gauss: 2,
+        }
+    }
+
     /// Thickness spacing `(y_max − y_min)/(layers − 1)`.
     pub fn layer_spacing(&self) -> Real {
         (self.y_max - self.y_min) / (self.layers as Real - 1.0)

@@ -588,20 +588,7 @@ mod tests {
     use crate::model::BodySetup;
 
     fn grid(nx: usize, ny: usize, h: Real) -> RectangleGrid {
-        RectangleGrid {
-            x_min: 0.0,
-            x_max: (nx - 1) as Real * h,
-            y_min: 0.0,
-            y_max: (ny - 1) as Real * h,
-            layers: ny,
-            refine_at: None,
-            fine_half_width: 0.0,
-            fine_spacing: Some(h),
-            growth: 1.0,
-            coarse_spacing: None,
-            support_factor: 2.0,
-            gauss: 2,
-        }
+        RectangleGrid::uniform((0.0, (nx - 1) as Real * h), (0.0, (ny - 1) as Real * h), h)
     }
 
     fn model(mode: GeometryMode, g: RectangleGrid, kappa: Real) -> Model {

@@ -16,20 +16,7 @@ const CP: Real = 500.0;
 
 /// A rectangle with uniform spacing `h` along x and through the thickness.
 fn grid(x: (Real, Real), y: (Real, Real), h: Real) -> RectangleGrid {
-    RectangleGrid {
-        x_min: x.0,
-        x_max: x.1,
-        y_min: y.0,
-        y_max: y.1,
-        layers: ((y.1 - y.0) / h).round() as usize + 1,
-        refine_at: None,
-        fine_half_width: 0.0,
-        fine_spacing: Some(h),
-        growth: 1.0,
-        coarse_spacing: None,
-        support_factor: 2.0,
-        gauss: 2,
-    }
+    RectangleGrid::uniform(x, y, h)
 }
 
 fn conductor(kappa: Real) -> Material {

@@ -9,20 +9,8 @@ use plugsim::math::Real;
 /// factor 2, 2×2 Gauss points.
 #[allow(dead_code)] // not every test binary uses every helper
 pub fn uniform_lattice(nx: usize, ny: usize, h: Real) -> RectangleGrid {
-    RectangleGrid {
-        x_min: 0.0,
-        x_max: (nx - 1) as Real * h,
-        y_min: 0.0,
-        y_max: (ny - 1) as Real * h,
-        layers: ny,
-        refine_at: Some(0.0),
-        fine_half_width: 0.0,
-        fine_spacing: None,
-        growth: 1.0,
-        coarse_spacing: None,
-        support_factor: 2.0,
-        gauss: 2,
-    }
+    let (w, t) = ((nx - 1) as Real * h, (ny - 1) as Real * h);
+    RectangleGrid { refine_at: Some(0.0), fine_spacing: None, ..RectangleGrid::uniform((0.0, w), (0.0, t), h) }
 }
 
 /// Borvik Case I without fracture on a narrower (60 mm), coarser (10-row)
