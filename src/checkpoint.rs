@@ -76,7 +76,7 @@ use crate::material::Material;
 use crate::math::{Real, Tensor3, Vec2};
 use crate::model::{BodyInfo, Gather, Model};
 use crate::particles::{FaceSide, ParticleFlags, Particles};
-use crate::quadrature::QuadraturePoints;
+use crate::quadrature::{QuadraturePoints, NO_CARRY};
 use crate::shape::ShapeTable;
 use crate::step::{Energies, Simulation, TimeStepRule};
 use std::fs::File;
@@ -88,8 +88,10 @@ pub const MAGIC: [u8; 8] = *b"PLUGCKPT";
 /// The format this build writes and the only one it reads.
 ///
 /// Version 1 (before heat conduction and crack growth were carried) lacks
-/// the conduction clock and the `CRAK` section; version 2 adds them.
-pub const FORMAT_VERSION: u32 = 2;
+/// the conduction clock and the `CRAK` section; version 2 adds them;
+/// version 3 adds the deformation-gradient jumps carried over crack changes
+/// (a column of `QUAD` and the `FCAR` section).
+pub const FORMAT_VERSION: u32 = 3;
 /// Subdirectory of a run's output directory that holds its checkpoints.
 pub const DIRECTORY: &str = "checkpoints";
 /// File name extension of a checkpoint.
@@ -625,7 +627,20 @@ fn write_payload<W: Write>(
             Col::F64(&side_reach),
         ],
     )?;
-    let QuadraturePoints { x0, weight, body, f, tau, eps_p, eps_p_rate, temperature, damage, pw } = &m.quad;
+    let QuadraturePoints {
+        x0,
+        weight,
+        body,
+        f,
+        tau,
+        eps_p,
+        eps_p_rate,
+        temperature,
+        damage,
+        pw,
+        f_carry_slot,
+        f_carry,
+    } = &m.quad;
     e.section(
         b"QUAD",
         &[
@@ -639,8 +654,10 @@ fn write_payload<W: Write>(
             Col::F64(temperature),
             Col::F64(damage),
             Col::T3(pw),
+            Col::U32(f_carry_slot),
         ],
     )?;
+    e.section(b"FCAR", &[Col::T3(f_carry)])?;
     let qo = offsets_u64(&m.qp_shape.offsets);
     e.section(b"QTAB", &table_cols(&m.qp_shape, &qo))?;
     let po = offsets_u64(&m.particle_shape.offsets);
@@ -836,8 +853,8 @@ fn sections(payload: &[u8]) -> Result<Sections<'_>, String> {
         if &tag == b"END!" {
             break;
         }
-        const KNOWN: [&[u8; 4]; 10] =
-            [b"META", b"PART", b"QUAD", b"QTAB", b"PTAB", b"GATH", b"BODY", b"FCON", b"CONT", b"CRAK"];
+        const KNOWN: [&[u8; 4]; 11] =
+            [b"META", b"PART", b"QUAD", b"FCAR", b"QTAB", b"PTAB", b"GATH", b"BODY", b"FCON", b"CONT", b"CRAK"];
         if !KNOWN.contains(&&tag) {
             return Err(format!("unknown section '{}'", String::from_utf8_lossy(&tag)));
         }
@@ -1029,8 +1046,15 @@ fn restore(all: &Sections, meta: &mut Dec, case: &Case) -> Result<(Simulation, R
         temperature: d.f64s()?,
         damage: d.f64s()?,
         pw: d.t3s()?,
+        f_carry_slot: d.u32s()?,
+        f_carry: {
+            d.finish()?;
+            let mut c = section(all, b"FCAR", "FCAR")?;
+            let v = c.t3s()?;
+            c.finish()?;
+            v
+        },
     };
-    d.finish()?;
     let q = &quad;
     same_len(
         "quadrature-point",
@@ -1046,8 +1070,12 @@ fn restore(all: &Sections, meta: &mut Dec, case: &Case) -> Result<(Simulation, R
             q.temperature.len(),
             q.damage.len(),
             q.pw.len(),
+            q.f_carry_slot.len(),
         ],
     )?;
+    if q.f_carry_slot.iter().any(|&s| s != NO_CARRY && s as usize >= q.f_carry.len()) {
+        return Err("a quadrature point names a carried deformation-gradient jump that does not exist".into());
+    }
 
     let qp_shape = read_table(&mut section(all, b"QTAB", "QTAB")?, nq, n, "quadrature")?;
     let particle_shape = read_table(&mut section(all, b"PTAB", "PTAB")?, n, n, "particle")?;

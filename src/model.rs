@@ -4,7 +4,7 @@
 use crate::discretize::RectangleGrid;
 use crate::geometry::GeometryMode;
 use crate::material::{Constitutive, Material, PointState};
-use crate::math::{Real, Vec2};
+use crate::math::{Real, Tensor3, Vec2};
 use crate::particles::{ParticleFlags, Particles};
 use crate::quadrature::QuadraturePoints;
 use crate::shape::{build_table, AllVisible, ShapeError, ShapeTable};
@@ -283,6 +283,17 @@ impl Model {
     /// Physical displacement at each particle `u(X_I) = Σ_J N_J(X_I) U_J`.
     pub fn physical(&self, field: &[Vec2]) -> Vec<Vec2> {
         (0..self.particles.len()).map(|i| self.particle_shape.interpolate(i, field)).collect()
+    }
+
+    /// The RK part of point `q`'s deformation gradient,
+    /// `I + Σ_I u_I ⊗ ∇N_I(X_q)` (+ the hoop stretch in axisymmetry),
+    /// from the current table: the same arithmetic, the same bits, as the
+    /// solver's material update (without the carried jump).
+    pub fn shape_deformation_gradient(&self, q: usize) -> Tensor3 {
+        let u = &self.particles.u;
+        let (gu, _) = self.qp_shape.gradient_pair(q, u, u);
+        let uq = if self.mode.needs_point_values() { self.qp_shape.interpolate(q, u) } else { Vec2::zeros() };
+        self.mode.deformation_gradient(&gu, &uq, &self.quad.x0[q], 1.0)
     }
 
     /// Lumped projection of a quadrature field onto the particles:

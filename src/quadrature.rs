@@ -29,7 +29,19 @@ pub struct QuadraturePoints {
     /// First Piola–Kirchhoff stress times the weight, `P w_q`, cached for the
     /// force gather, N·m (per unit depth).
     pub pw: Vec<Tensor3>,
+    /// Where point `q`'s deformation gradient carries a jump over crack
+    /// changes: an index into [`QuadraturePoints::f_carry`], or
+    /// [`NO_CARRY`]. `F = I + Σ_I u_I ⊗ ∇N_I(X_q) + f_carry[slot]`
+    /// (`crate::fracture` module doc, "deformation gradient across a crack
+    /// change").
+    pub f_carry_slot: Vec<u32>,
+    /// The carried jumps, one per point that has one (few: the points next
+    /// to crack paths).
+    pub f_carry: Vec<Tensor3>,
 }
+
+/// [`QuadraturePoints::f_carry_slot`] of a point without a carried jump.
+pub const NO_CARRY: u32 = u32::MAX;
 
 impl QuadraturePoints {
     pub fn len(&self) -> usize {
@@ -51,6 +63,26 @@ impl QuadraturePoints {
         self.temperature.push(s.temperature);
         self.damage.push(s.damage);
         self.pw.push(Tensor3::zeros());
+        self.f_carry_slot.push(NO_CARRY);
+    }
+
+    /// Add `jump` to the deformation gradient carried by point `q`.
+    pub fn add_f_carry(&mut self, q: usize, jump: &Tensor3) {
+        match self.f_carry_slot[q] {
+            NO_CARRY => {
+                self.f_carry_slot[q] = self.f_carry.len() as u32;
+                self.f_carry.push(*jump);
+            }
+            slot => self.f_carry[slot as usize] += jump,
+        }
+    }
+
+    /// The deformation gradient carried by point `q` (zero if none).
+    pub fn f_carry_of(&self, q: usize) -> Tensor3 {
+        match self.f_carry_slot[q] {
+            NO_CARRY => Tensor3::zeros(),
+            slot => self.f_carry[slot as usize],
+        }
     }
 
     /// The material state of point `q`, gathered from the columns.
@@ -81,5 +113,6 @@ impl QuadraturePoints {
         p(&mut self.temperature, order);
         p(&mut self.damage, order);
         p(&mut self.pw, order);
+        p(&mut self.f_carry_slot, order);
     }
 }

@@ -7,6 +7,7 @@ use crate::material::{Constitutive, StepKinematics};
 use crate::math::{ddot, determinant_2d, mul_2d, skew, sym, try_inverse_2d, Real, Tensor3, Vec2};
 use crate::model::{constrain, Model};
 use crate::particles::ParticleFlags;
+use crate::quadrature::NO_CARRY;
 use crate::thermal::{HeatConduction, HeatError};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -400,6 +401,7 @@ impl Simulation {
         let m = &mut self.model;
         let (tab, u, v, mode, mats) = (&m.qp_shape, &m.particles.u, &m.particles.v, m.mode, &m.materials);
         let q = &mut m.quad;
+        let carried = &q.f_carry;
         let bad = (
             q.f.par_iter_mut(),
             q.tau.par_iter_mut(),
@@ -412,10 +414,11 @@ impl Simulation {
             &q.x0,
             &q.weight,
             &q.body,
+            &q.f_carry_slot,
         )
             .into_par_iter()
             .enumerate()
-            .map(|(qi, (f, tau, eps_p, eps_rate, temp, dmg, pw, work, x0, w, body))| {
+            .map(|(qi, (f, tau, eps_p, eps_rate, temp, dmg, pw, work, x0, w, body, carry))| {
                 // Legend: gu = grad U, gv = grad V (2x2), uq/vq = interpolated U, V
                 // (only read in axisymmetry). The 3x3 algebra uses the block
                 // form of 2D kinematics (same bits as the general products).
@@ -425,7 +428,11 @@ impl Simulation {
                 } else {
                     (Vec2::zeros(), Vec2::zeros())
                 };
-                let F_new = mode.deformation_gradient(&gu, &uq, x0, 1.0);
+                let mut F_new = mode.deformation_gradient(&gu, &uq, x0, 1.0);
+                if *carry != NO_CARRY {
+                    // The jump carried over crack changes (`crate::fracture`).
+                    F_new += carried[*carry as usize];
+                }
                 let F_dot = mode.deformation_gradient(&gv, &vq, x0, 0.0);
                 let F_mid = (*f + F_new) * 0.5;
                 let J = determinant_2d(&F_new);

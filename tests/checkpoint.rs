@@ -230,6 +230,7 @@ fn resumed_fracture_run_is_bit_identical_to_an_uninterrupted_one() {
     let at = from.cracks.as_ref().expect("fracture is on");
     let final_events = &end.cracks.as_ref().unwrap().events;
     assert!(!at.cracks.is_empty(), "a crack nucleated before the checkpoint");
+    assert!(!from.model.quad.f_carry.is_empty(), "deformation-gradient jumps are carried across the checkpoint");
     assert!(
         final_events.len() > at.events.len()
             && final_events[at.events.len()..].iter().any(|e| e.crack < at.cracks.len()),
@@ -349,16 +350,18 @@ fn checkpoint_of_another_format_version_is_refused_naming_both() {
 /// Format 1 (written before crack growth and heat conduction were carried)
 /// is refused, naming both versions, rather than resumed without them.
 #[test]
-fn version_1_checkpoint_is_refused_naming_both_versions() {
-    assert_eq!(FORMAT_VERSION, 2);
+fn older_format_version_checkpoint_is_refused_naming_both_versions() {
+    // Version 3 added the deformation-gradient jumps carried over crack
+    // changes; a version-2 file lacks them.
+    assert_eq!(FORMAT_VERSION, 3);
     let case = case(STRIKE, &["time.end=1e-6"]);
-    let dir = scratch("version-1");
+    let dir = scratch("version-2");
     let path = run_until(&case, &dir, 2);
-    corrupt(&path, 8, &1u32.to_le_bytes());
+    corrupt(&path, 8, &2u32.to_le_bytes());
     let e = checkpoint::read(&path).unwrap_err().to_string();
-    assert!(e.contains("format version 1 ") && e.contains("reads format version 2"), "{e}");
+    assert!(e.contains("format version 2 ") && e.contains("reads format version 3"), "{e}");
     let e = resume(&config(&dir, None), &mut |_| {}).unwrap_err().to_string();
-    assert!(e.contains("format version 1 ") && e.contains("format version 2"), "{e}");
+    assert!(e.contains("format version 2 ") && e.contains("format version 3"), "{e}");
 }
 
 #[test]

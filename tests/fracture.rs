@@ -614,3 +614,61 @@ fn run_stops_after_the_projectile_is_released() {
     assert!(bad.is_err_and(|e| e.to_string().contains("time.stop_after_release")));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A crack change rebuilds the shape functions next to the path, which
+/// changes the RK interpolation of the displacement but does not move the
+/// material: the deformation gradient `F` of every quadrature point must not
+/// jump (`plugsim::fracture` module doc). Across a sheared band the raw
+/// `I + Σ u ∇N` of the new one-sided rows differs from the old by O(1); the
+/// jump is carried, so `F` is continuous to round-off, and only points whose
+/// rows changed carry one.
+#[test]
+fn deformation_gradient_is_continuous_across_crack_changes() {
+    let (nx, ny) = (25, 9);
+    let mut m = plate(nx, ny);
+    let top = (ny - 1) as Real * H;
+    let xc = 10.0 * H;
+    // A vertical shear band of width ~H: the criterion field peaks on it and
+    // the displacement shears across it (a non-linear field, up to 2 H of slip).
+    set_field(&mut m, |x| 0.6 * (-((x.x - xc) / H).powi(2)).exp());
+    for i in 0..m.particles.len() {
+        let x = m.particles.x0[i];
+        m.particles.u[i] = Vec2::new(0.0, -H * (1.0 + ((x.x - xc) / H).tanh()) * (0.5 + 0.5 * x.y / top));
+    }
+    // The state after a material update: stored F from the current rows.
+    for q in 0..m.quad.len() {
+        m.quad.f[q] = m.shape_deformation_gradient(q);
+    }
+    let mut g = CrackGrowth::new(params(Criterion::EffectiveStrain));
+    let mut largest_jump: Real = 0.0;
+    for step in 1..=30u64 {
+        let before: Vec<_> =
+            (0..m.quad.len()).map(|q| m.shape_deformation_gradient(q) + m.quad.f_carry_of(q)).collect();
+        let n_events = g.events.len();
+        g.grow(&mut m, step as Real * 1e-8, step).unwrap();
+        if g.events.len() == n_events {
+            continue;
+        }
+        for (q, f_before) in before.iter().enumerate() {
+            let raw = m.shape_deformation_gradient(q);
+            let f_after = raw + m.quad.f_carry_of(q);
+            assert!(
+                (f_after - f_before).norm() < 1e-13,
+                "step {step}: F of qp {q} jumped by {:e}",
+                (f_after - f_before).norm()
+            );
+            largest_jump = largest_jump.max((raw - f_before).norm());
+        }
+    }
+    assert!(g.cracks.first().is_some_and(|c| c.arrested.is_some()), "the crack runs through: {:?}", g.events);
+    // Without the carry, F would have jumped by this much at a point next to
+    // the path: the test exercises a real jump, not round-off.
+    eprintln!("largest jump of the raw F at a crack change: {largest_jump:.3e}");
+    assert!(largest_jump > 1e-2, "largest raw jump {largest_jump:e}");
+    // Points far from the path keep no carry.
+    for q in 0..m.quad.len() {
+        if (m.quad.x0[q].x - xc).abs() > 6.0 * H {
+            assert_eq!(m.quad.f_carry_slot[q], plugsim::quadrature::NO_CARRY, "qp {q} at {:?}", m.quad.x0[q]);
+        }
+    }
+}

@@ -11,7 +11,7 @@ use super::visibility::{CrackSegments, CrackVisibility};
 use super::{Criterion, FractureError, FractureParameters};
 use crate::geometry::GeometryMode;
 use crate::material::Constitutive;
-use crate::math::{Real, Vec2};
+use crate::math::{Real, Tensor3, Vec2};
 use crate::model::{Gather, Model};
 use crate::neighbors::CellGrid;
 use crate::particles::{FaceSide, ParticleFlags};
@@ -785,6 +785,9 @@ impl CrackGrowth {
                 touched[model.qp_shape.index[k] as usize] = true;
             }
         }
+        // The RK deformation gradients before the change (module doc:
+        // "deformation gradient across a crack change").
+        let f_before: Vec<Tensor3> = rows_q.iter().map(|&q| model.shape_deformation_gradient(q)).collect();
         let p = &model.particles;
         let vis = CrackVisibility { segments: &self.segments, x0: &p.x0, face_side: &p.face_side };
         let mut qp_shape = std::mem::take(&mut model.qp_shape);
@@ -804,6 +807,12 @@ impl CrackGrowth {
         for &q in &rows_q {
             for k in model.qp_shape.range(q) {
                 touched[model.qp_shape.index[k] as usize] = true;
+            }
+        }
+        for (&q, before) in rows_q.iter().zip(&f_before) {
+            let after = model.shape_deformation_gradient(q);
+            if after != *before {
+                model.quad.add_f_carry(q, &(before - after));
             }
         }
         model.gather = Gather::new(&model.qp_shape, n);

@@ -124,6 +124,25 @@
 //!   momentum is then restored as above. Such particles' masses are no
 //!   longer row sums (`arrest_at_the_far_surface_without_running_along_it`
 //!   arrives at 45° and checks mass and momentum).
+//! - **Deformation gradient across a crack change.** SPEC §2 computes
+//!   `F = I + Σ_I u_I ⊗ ∇N_I(X)` from the total displacement and §9
+//!   rebuilds the shape functions next to a new segment. The rebuild changes
+//!   the RK interpolation of the displacement, not the material: where the
+//!   field is non-linear across a shear band, the new one-sided rows give a
+//!   different `F` for the same particle positions, and in strongly sheared
+//!   material that jump can invert the point. In the fine axisymmetric
+//!   Borvik Case I with the damage criterion (`ε̄ ≈ 1.1`, `D ≈ 0.6` around
+//!   the tip), a propagation at step 608 inverted a point next to the new
+//!   segment in step 609 (`J = −0.20`), and the run stopped at 12.3 µs.
+//!   So every point whose RK `F` changes in a rebuild carries the jump:
+//!   `F = I + Σ u ∇N + F_c`, with `F_c` the sum over crack changes of
+//!   (`F` before − `F` after) at that point
+//!   ([`crate::quadrature::QuadraturePoints::f_carry`]). From then on `F`
+//!   advances by the new rows' `Σ Δu ∇N`, the rate form of the same total
+//!   measure. Points whose rows did not change carry nothing and keep
+//!   their bits. With the carry the same run perforates at 27.3 µs and
+//!   runs through (`deformation_gradient_is_continuous_across_crack_changes`;
+//!   the checkpoint carries `F_c`).
 //! - Crack segments are extended by `5 δ` beyond each end that is not a
 //!   growing tip, so sight lines grazing a split vertex are blocked.
 //! - After a change the internal force is recomputed from the new table
