@@ -516,6 +516,7 @@ fn crack_bytes(c: &CrackGrowth) -> std::io::Result<Vec<u8>> {
         fan_angle,
         offset_ratio,
         nucleation_distance_factor,
+        erode_inverted,
     } = c.params;
     e.u32(match criterion {
         Criterion::EffectiveStrain => 0,
@@ -527,6 +528,7 @@ fn crack_bytes(c: &CrackGrowth) -> std::io::Result<Vec<u8>> {
     {
         e.f64(v)?;
     }
+    e.u32(erode_inverted as u32)?;
     e.u64(c.cracks.len() as u64)?;
     for k in &c.cracks {
         let Crack { id, vertices, tip, offset, nucleated, arrested } = k;
@@ -640,7 +642,9 @@ fn write_payload<W: Write>(
         pw,
         f_carry_slot,
         f_carry,
+        eroded,
     } = &m.quad;
+    let eroded_bytes: Vec<u8> = eroded.iter().map(|&e| e as u8).collect();
     e.section(
         b"QUAD",
         &[
@@ -655,6 +659,7 @@ fn write_payload<W: Write>(
             Col::F64(damage),
             Col::T3(pw),
             Col::U32(f_carry_slot),
+            Col::U8(&eroded_bytes),
         ],
     )?;
     e.section(b"FCAR", &[Col::T3(f_carry)])?;
@@ -1047,6 +1052,7 @@ fn restore(all: &Sections, meta: &mut Dec, case: &Case) -> Result<(Simulation, R
         damage: d.f64s()?,
         pw: d.t3s()?,
         f_carry_slot: d.u32s()?,
+        eroded: d.u8s()?.into_iter().map(|b| b != 0).collect(),
         f_carry: {
             d.finish()?;
             let mut c = section(all, b"FCAR", "FCAR")?;
@@ -1071,6 +1077,7 @@ fn restore(all: &Sections, meta: &mut Dec, case: &Case) -> Result<(Simulation, R
             q.damage.len(),
             q.pw.len(),
             q.f_carry_slot.len(),
+            q.eroded.len(),
         ],
     )?;
     if q.f_carry_slot.iter().any(|&s| s != NO_CARRY && s as usize >= q.f_carry.len()) {
@@ -1224,6 +1231,11 @@ fn restore_cracks(all: &Sections, case: &Case, model: &Model) -> Result<Option<C
     }
     let [critical_effective_strain, critical_damage, radius_factor, fan_angle, offset_ratio, nucleation_distance_factor] =
         v;
+    let erode_inverted = match d.u32()? {
+        0 => false,
+        1 => true,
+        other => return Err(format!("erosion flag {other} is neither 0 nor 1")),
+    };
     let params = FractureParameters {
         criterion,
         critical_effective_strain,
@@ -1232,6 +1244,7 @@ fn restore_cracks(all: &Sections, case: &Case, model: &Model) -> Result<Option<C
         fan_angle,
         offset_ratio,
         nucleation_distance_factor,
+        erode_inverted,
     };
     if params != case.fracture {
         return Err("the fracture parameters do not match the case".into());

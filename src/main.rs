@@ -577,6 +577,12 @@ fn drive(
     if let Some(t) = s.perforation {
         println!("  plate perforated at {:.3} us (plug first cut out)", t * 1e6);
     }
+    if s.eroded_points > 0 {
+        println!(
+            "  eroded: {} quadrature points inverted after meeting the crack criterion and carry no stress (history.csv: eroded_points)",
+            s.eroded_points
+        );
+    }
     match &s.plug {
         Some(p) => {
             let v = p.velocity();

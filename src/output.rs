@@ -18,7 +18,9 @@ use std::path::{Path, PathBuf};
 /// rigid body (`plug_mass`, kg or kg/m in plane strain, and its
 /// mass-averaged velocity `plug_vx, plug_vy`, m/s; all 0 before, see
 /// [`crate::plug`]) with `perforation_time`, the time of the step after
-/// which it was first found (s; 0 before). Each rigid body `NAME` adds `NAME_x, NAME_y` (m), `NAME_vx, NAME_vy` (m/s),
+/// which it was first found (s; 0 before), and `eroded_points`, the number
+/// of quadrature points eroded so far (inverted after failing, see
+/// [`crate::fracture`]). Each rigid body `NAME` adds `NAME_x, NAME_y` (m), `NAME_vx, NAME_vy` (m/s),
 /// `NAME_fx, NAME_fy` (contact force on the body, N) and `NAME_contacts`.
 pub const HISTORY_COLUMNS: &[&str] = &[
     "time",
@@ -35,6 +37,7 @@ pub const HISTORY_COLUMNS: &[&str] = &[
     "plug_vx",
     "plug_vy",
     "perforation_time",
+    "eroded_points",
 ];
 
 /// Columns of `cracks.csv`: one row per crack event; `particles` lists the
@@ -231,6 +234,7 @@ impl OutputWriter {
             None => row.extend([0.0; 3]),
         }
         row.push(self.plug.first_cut.unwrap_or(0.0));
+        row.push(sim.model.quad.eroded.iter().filter(|&&e| e).count() as Real);
         if let Some(c) = &sim.contact {
             for b in 0..c.bodies.len() {
                 let s = c.sample(b).expect("body exists");

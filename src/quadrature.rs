@@ -38,6 +38,9 @@ pub struct QuadraturePoints {
     /// The carried jumps, one per point that has one (few: the points next
     /// to crack paths).
     pub f_carry: Vec<Tensor3>,
+    /// Eroded: the point inverted after meeting the crack criterion and
+    /// carries no stress from then on (`crate::fracture` module doc).
+    pub eroded: Vec<bool>,
 }
 
 /// [`QuadraturePoints::f_carry_slot`] of a point without a carried jump.
@@ -64,6 +67,7 @@ impl QuadraturePoints {
         self.damage.push(s.damage);
         self.pw.push(Tensor3::zeros());
         self.f_carry_slot.push(NO_CARRY);
+        self.eroded.push(false);
     }
 
     /// Add `jump` to the deformation gradient carried by point `q`.
@@ -114,5 +118,6 @@ impl QuadraturePoints {
         p(&mut self.damage, order);
         p(&mut self.pw, order);
         p(&mut self.f_carry_slot, order);
+        p(&mut self.eroded, order);
     }
 }

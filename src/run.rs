@@ -98,6 +98,9 @@ pub struct RunSummary {
     /// The plug at the end of the run, if the cracks cut one out under the
     /// first rigid body ([`crate::plug`]).
     pub plug: Option<crate::plug::Plug>,
+    /// Quadrature points eroded by the end (inverted after failing,
+    /// [`crate::fracture`]).
+    pub eroded_points: usize,
     /// Velocity of each rigid body at the end, (name, (vx, vy)) m/s.
     pub rigid_velocities: Vec<(String, [Real; 2])>,
     /// Time of each rigid body's last contact (history rows), s.
@@ -477,6 +480,7 @@ fn time_loop(
     Ok(RunSummary {
         perforation,
         plug,
+        eroded_points: sim.model.quad.eroded.iter().filter(|&&e| e).count(),
         cracks,
         separation,
         rigid_velocities,

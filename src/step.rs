@@ -398,10 +398,12 @@ impl Simulation {
         // While cracks grow, points fractured by their damage carry only
         // compression (`material::fractured`).
         let cracking = self.cracks.as_ref().is_some_and(|c| c.params.critical_value().is_some());
+        // Erosion of inverted failed points (`crate::fracture` module doc).
+        let erosion = self.cracks.as_ref().map(|c| c.params).filter(|p| cracking && p.erode_inverted);
         let m = &mut self.model;
         let (tab, u, v, mode, mats) = (&m.qp_shape, &m.particles.u, &m.particles.v, m.mode, &m.materials);
         let q = &mut m.quad;
-        let carried = &q.f_carry;
+        let (carried, x0s, weights, bodies) = (&q.f_carry, &q.x0, &q.weight, &q.body);
         let bad = (
             q.f.par_iter_mut(),
             q.tau.par_iter_mut(),
@@ -411,14 +413,17 @@ impl Simulation {
             q.damage.par_iter_mut(),
             q.pw.par_iter_mut(),
             self.work_scratch.par_iter_mut(),
-            &q.x0,
-            &q.weight,
-            &q.body,
+            q.eroded.par_iter_mut(),
             &q.f_carry_slot,
         )
             .into_par_iter()
             .enumerate()
-            .map(|(qi, (f, tau, eps_p, eps_rate, temp, dmg, pw, work, x0, w, body, carry))| {
+            .map(|(qi, (f, tau, eps_p, eps_rate, temp, dmg, pw, work, eroded, carry))| {
+                if *eroded {
+                    *work = 0.0;
+                    return None;
+                }
+                let (x0, w, body) = (&x0s[qi], &weights[qi], &bodies[qi]);
                 // Legend: gu = grad U, gv = grad V (2x2), uq/vq = interpolated U, V
                 // (only read in axisymmetry). The 3x3 algebra uses the block
                 // form of 2D kinematics (same bits as the general products).
@@ -436,15 +441,18 @@ impl Simulation {
                 let F_dot = mode.deformation_gradient(&gv, &vq, x0, 0.0);
                 let F_mid = (*f + F_new) * 0.5;
                 let J = determinant_2d(&F_new);
-                let Some(F_mid_inv) = try_inverse_2d(&F_mid) else {
-                    return Some((qi, J));
+                let (F_mid_inv, F_inv) = match (try_inverse_2d(&F_mid), try_inverse_2d(&F_new)) {
+                    (Some(a), Some(b)) if J > 0.0 && J.is_finite() => (a, b),
+                    _ if erosion.is_some_and(|p| p.point_failed(*eps_p, *dmg)) => {
+                        // Inverted after failing: eroded, the run goes on.
+                        *eroded = true;
+                        *tau = Tensor3::zeros();
+                        *pw = Tensor3::zeros();
+                        *work = 0.0;
+                        return None;
+                    }
+                    _ => return Some((qi, J)),
                 };
-                let Some(F_inv) = try_inverse_2d(&F_new) else {
-                    return Some((qi, J));
-                };
-                if J <= 0.0 || !J.is_finite() {
-                    return Some((qi, J));
-                }
                 let l = mul_2d(&F_dot, &F_mid_inv);
                 let kin = StepKinematics { d: sym(&l), w: skew(&l), dt };
                 let old = crate::material::PointState {

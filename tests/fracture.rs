@@ -672,3 +672,66 @@ fn deformation_gradient_is_continuous_across_crack_changes() {
         }
     }
 }
+
+/// Erosion of inverted failed points (`plugsim::fracture` module doc): a
+/// point that inverts after meeting the crack criterion is eroded — no
+/// stress, no force, for good — and the run goes on; a point that inverts
+/// without having failed, or any inverted point with `erode_inverted =
+/// false`, still stops the run with the inverted-point error.
+#[test]
+fn inverted_failed_points_are_eroded_and_others_stop_the_run() {
+    let (nx, ny) = (11, 11);
+    let centre = Vec2::new(5.0 * H, 5.0 * H);
+    let setup = |failed_strain: Real, erode: bool| {
+        let mut m = plate(nx, ny);
+        // The centre particle pushed through its right neighbours: the
+        // points of its support invert in the first step.
+        let c = id(&m, 5, 5);
+        m.particles.u[c].x = 3.0 * H;
+        for q in 0..m.quad.len() {
+            if (m.quad.x0[q] - centre).norm() < 3.5 * H {
+                m.quad.eps_p[q] = failed_strain;
+            }
+        }
+        let mut sim = Simulation::new(m, TimeStepRule::Cfl { safety: 0.5 });
+        sim.cracks =
+            Some(CrackGrowth::new(FractureParameters { erode_inverted: erode, ..params(Criterion::EffectiveStrain) }));
+        sim
+    };
+    let inverted = |sim: &mut Simulation| match sim.step() {
+        Err(plugsim::step::SolverError::Inverted { x, y, .. }) => Vec2::new(x, y),
+        other => panic!("expected the inverted-point error, got {other:?}"),
+    };
+    // Failed (ε̄ = 0.5 ≥ ε_cr = 0.3) and erosion on: the step succeeds.
+    let mut sim = setup(0.5, true);
+    let momentum = sim.model.particles.momentum();
+    sim.step().unwrap();
+    let q = &sim.model.quad;
+    let eroded: Vec<usize> = (0..q.len()).filter(|&k| q.eroded[k]).collect();
+    assert!(!eroded.is_empty(), "some points inverted and were eroded");
+    for &k in &eroded {
+        assert!((q.x0[k] - centre).norm() < 3.5 * H, "only failed points erode: {k} at {:?}", q.x0[k]);
+        assert_eq!(q.tau[k], plugsim::math::Tensor3::zeros());
+        assert_eq!(q.pw[k], plugsim::math::Tensor3::zeros());
+    }
+    // Eroded for good; nothing else inverts; the forces stay finite.
+    for _ in 0..5 {
+        sim.step().unwrap();
+    }
+    let q = &sim.model.quad;
+    assert!(eroded.iter().all(|&k| q.eroded[k] && q.tau[k] == plugsim::math::Tensor3::zeros()));
+    assert!(sim.model.particles.f_int.iter().all(|f| f.x.is_finite() && f.y.is_finite()));
+    // Erosion removes stress, not mass: the free plate keeps its momentum
+    // (internal forces sum to zero with or without the eroded points).
+    let dp = (sim.model.particles.momentum() - momentum).norm();
+    let scale = sim.model.particles.total_mass() * sim.model.particles.v.iter().map(|v| v.norm()).fold(1.0, Real::max);
+    assert!(dp < 1e-9 * scale, "momentum changed by {dp:e}");
+    eprintln!("eroded {} of {} points", eroded.len(), q.len());
+
+    // Not failed: the run stops, naming a point next to the centre.
+    let x = inverted(&mut setup(0.1, true));
+    assert!((x - centre).norm() < 3.5 * H, "{x:?}");
+    // Erosion off: the run stops even where the points failed.
+    let x = inverted(&mut setup(0.5, false));
+    assert!((x - centre).norm() < 3.5 * H, "{x:?}");
+}

@@ -143,6 +143,25 @@
 //!   their bits. With the carry the same run perforates at 27.3 µs and
 //!   runs through (`deformation_gradient_is_continuous_across_crack_changes`;
 //!   the checkpoint carries `F_c`).
+//! - **Erosion of inverted failed points.** A crack tip advances by at
+//!   most one particle per step and only into material that meets the
+//!   criterion and is not compressed (triaxiality ≥ −1/3). Meanwhile the
+//!   failed material around a stalled tip keeps deforming, and under the
+//!   projectile's corner it can be sheared and crushed until a quadrature
+//!   point inverts — e.g. the fine plane-strain Borvik Case I with the
+//!   damage criterion: one corner crack through at 26.7 µs, the other
+//!   stalled in compression for 12 µs, then a point beside it at
+//!   `ε̄ ≈ 1.3`, `D ≈ 0.9` inverted at 35.8 µs. Such a point has already
+//!   failed by the case's own criterion, so it is **eroded** instead of
+//!   stopping the run: it carries no stress (and so no internal force)
+//!   from then on, keeps its state for the output and the criterion, and
+//!   its particles keep their mass — element erosion as in LS-DYNA's
+//!   negative-volume and failure erosion, for points only. A point that
+//!   inverts without meeting the criterion still stops the run with the
+//!   inverted-point error, as does every inversion with
+//!   `fracture.erode_inverted = false`. `history.csv` counts the eroded
+//!   points (`eroded_points`) and the run summary reports them
+//!   (`inverted_failed_points_are_eroded_and_others_stop_the_run`).
 //! - Crack segments are extended by `5 δ` beyond each end that is not a
 //!   growing tip, so sight lines grazing a split vertex are blocked.
 //! - After a change the internal force is recomputed from the new table
@@ -205,6 +224,11 @@ pub struct FractureParameters {
     /// steps after it); the two corners of Borvik's 20 mm projectile are
     /// ~40 spacings apart.
     pub nucleation_distance_factor: Real,
+    /// Erode a quadrature point that inverts (`J ≤ 0`) after it has met the
+    /// crack criterion, instead of stopping the run (module doc, "erosion
+    /// of inverted failed points"). Default true; false stops the run at
+    /// the first inverted point, failed or not.
+    pub erode_inverted: bool,
 }
 
 impl Default for FractureParameters {
@@ -217,6 +241,7 @@ impl Default for FractureParameters {
             fan_angle: 120.0,
             offset_ratio: 0.01,
             nucleation_distance_factor: 10.0,
+            erode_inverted: true,
         }
     }
 }
@@ -246,6 +271,17 @@ impl FractureParameters {
             p.push(("nucleation_distance_factor", format!("must be >= 0, got {}", self.nucleation_distance_factor)));
         }
         p
+    }
+
+    /// Whether a quadrature point with plastic strain `eps_p` and damage
+    /// `damage` meets the crack criterion (false without one).
+    #[inline]
+    pub fn point_failed(&self, eps_p: Real, damage: Real) -> bool {
+        match self.criterion {
+            Criterion::EffectiveStrain => eps_p >= self.critical_effective_strain,
+            Criterion::Damage => damage >= self.critical_damage,
+            Criterion::None => false,
+        }
     }
 
     /// The critical value of the chosen criterion (`None`: no cracks).
