@@ -579,7 +579,7 @@ fn drive(
     }
     if s.eroded_points > 0 {
         println!(
-            "  eroded: {} quadrature points inverted after meeting the crack criterion or next to a crack, and carry no stress (history.csv: eroded_points)",
+            "  eroded: {} quadrature points inverted after meeting the crack criterion and carry no stress (history.csv: eroded_points)",
             s.eroded_points
         );
     }

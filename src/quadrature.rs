@@ -38,8 +38,8 @@ pub struct QuadraturePoints {
     /// The carried jumps, one per point that has one (few: the points next
     /// to crack paths).
     pub f_carry: Vec<Tensor3>,
-    /// Eroded: the point inverted after meeting the crack criterion (or
-    /// next to a crack) and carries no stress from then on (`crate::fracture` module doc).
+    /// Eroded: the point inverted after meeting the crack criterion and
+    /// carries no stress from then on (`crate::fracture` module doc).
     pub eroded: Vec<bool>,
 }
 

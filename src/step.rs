@@ -399,13 +399,9 @@ impl Simulation {
         // compression (`material::fractured`).
         let cracking = self.cracks.as_ref().is_some_and(|c| c.params.critical_value().is_some());
         // Erosion of inverted failed points (`crate::fracture` module doc).
-        let erosion = self.cracks.as_ref().filter(|c| cracking && c.params.erode_inverted);
+        let erosion = self.cracks.as_ref().map(|c| c.params).filter(|p| cracking && p.erode_inverted);
         let m = &mut self.model;
         let (tab, u, v, mode, mats) = (&m.qp_shape, &m.particles.u, &m.particles.v, m.mode, &m.materials);
-        let spacing = &m.particles.spacing;
-        // The local spacing at point q: the finest of its row's particles.
-        let row_spacing =
-            |q: usize| tab.range(q).map(|k| spacing[tab.index[k] as usize]).fold(Real::INFINITY, Real::min);
         let q = &mut m.quad;
         let (carried, x0s, weights, bodies) = (&q.f_carry, &q.x0, &q.weight, &q.body);
         let bad = (
@@ -447,9 +443,8 @@ impl Simulation {
                 let J = determinant_2d(&F_new);
                 let (F_mid_inv, F_inv) = match (try_inverse_2d(&F_mid), try_inverse_2d(&F_new)) {
                     (Some(a), Some(b)) if J > 0.0 && J.is_finite() => (a, b),
-                    _ if erosion.is_some_and(|c| c.erodes(x0, row_spacing(qi), *eps_p, *dmg)) => {
-                        // Inverted after failing, or next to a crack:
-                        // eroded, the run goes on.
+                    _ if erosion.is_some_and(|p| p.point_failed(*eps_p, *dmg)) => {
+                        // Inverted after failing: eroded, the run goes on.
                         *eroded = true;
                         *tau = Tensor3::zeros();
                         *pw = Tensor3::zeros();

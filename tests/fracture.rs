@@ -735,26 +735,3 @@ fn inverted_failed_points_are_eroded_and_others_stop_the_run() {
     let x = inverted(&mut setup(0.5, false));
     assert!((x - centre).norm() < 3.5 * H, "{x:?}");
 }
-
-/// Which inverted points erode: failed ones anywhere, and unfailed ones in
-/// a crack's process zone (within `R = radius_factor × h` of its path).
-#[test]
-fn erosion_covers_failed_points_and_the_crack_process_zone() {
-    let mut m = plate(21, 11);
-    let mut g = CrackGrowth::new(params(Criterion::EffectiveStrain));
-    // An edge crack down from the top surface at x = 10 H to y = 6 H.
-    let path: Vec<usize> = (6..=10).rev().map(|j| id(&m, 10, j)).collect();
-    g.insert_crack(&mut m, &path, false).unwrap();
-    let r = g.params.radius_factor * H;
-    let at = |x: Real, y: Real| Vec2::new(x * H, y * H);
-    // Not failed (ε̄ = 0.1 < 0.3): erodes within R of the path only.
-    assert!(g.erodes(&at(10.5, 8.0), H, 0.1, 0.0), "beside the path");
-    assert!(g.erodes(&at(10.0, 6.0 - 0.9 * r / H), H, 0.1, 0.0), "ahead of the tip, within R");
-    assert!(!g.erodes(&at(10.0, 6.0 - 1.1 * r / H), H, 0.1, 0.0), "ahead of the tip, beyond R");
-    assert!(!g.erodes(&at(3.0, 3.0), H, 0.1, 0.0), "far from the crack");
-    // Failed: anywhere.
-    assert!(g.erodes(&at(3.0, 3.0), H, 0.5, 0.0));
-    // Erosion off: never.
-    g.params.erode_inverted = false;
-    assert!(!g.erodes(&at(10.5, 8.0), H, 0.5, 0.0));
-}

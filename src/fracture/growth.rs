@@ -271,17 +271,6 @@ impl CrackGrowth {
         CrackVisibility { segments: &self.segments, x0: &model.particles.x0, face_side: &model.particles.face_side }
     }
 
-    /// Whether an inverted quadrature point at `x0` erodes (module doc,
-    /// "erosion of inverted failed points"): erosion is on, and the point
-    /// meets the crack criterion (`eps_p`, `damage`) or lies in a crack's
-    /// process zone — within the search radius `R` (`radius_factor ×
-    /// spacing`, the local particle spacing) of a crack path.
-    pub fn erodes(&self, x0: &Vec2, spacing: Real, eps_p: Real, damage: Real) -> bool {
-        self.params.erode_inverted
-            && (self.params.point_failed(eps_p, damage)
-                || self.segments.distance(x0) <= self.params.radius_factor * spacing)
-    }
-
     /// Per-particle criterion value: the lumped projection of the
     /// quadrature field (module doc of [`crate::fracture`]).
     pub fn criterion_value(&self, model: &Model, i: usize) -> Real {

@@ -146,25 +146,22 @@
 //! - **Erosion of inverted failed points.** A crack tip advances by at
 //!   most one particle per step and only into material that meets the
 //!   criterion and is not compressed (triaxiality ≥ −1/3). Meanwhile the
-//!   material around a stalled tip keeps deforming, and under the
+//!   failed material around a stalled tip keeps deforming, and under the
 //!   projectile's corner it can be sheared and crushed until a quadrature
 //!   point inverts — e.g. the fine plane-strain Borvik Case I with the
 //!   damage criterion: one corner crack through at 26.7 µs, the other
-//!   stalled in compression for 12 µs, then points beside its tip
-//!   (`ε̄ ≈ 1.2–1.3`, `D ≈ 0.45–0.9`) inverted at 35.8 µs. Such a point is
-//!   **eroded** instead of stopping the run if it has failed by the case's
-//!   own criterion, or lies in a crack's process zone — within the search
-//!   radius `R` of a crack path, where the material is being torn apart by
-//!   the crack and only the one-particle-per-step advance holds it
-//!   together. An eroded point carries no stress (and so no internal
-//!   force) from then on, keeps its state for the output and the
-//!   criterion, and its particles keep their mass: element erosion as in
-//!   LS-DYNA's failure and negative-volume erosion, for points only. Any
-//!   other inversion still stops the run with the inverted-point error, as
-//!   does every inversion with `fracture.erode_inverted = false`.
-//!   `history.csv` counts the eroded points (`eroded_points`) and the run
-//!   summary reports them (`inverted_failed_points_are_eroded_and_others_stop_the_run`,
-//!   `erosion_covers_failed_points_and_the_crack_process_zone`).
+//!   stalled in compression for 12 µs, then a point beside it at
+//!   `ε̄ ≈ 1.3`, `D ≈ 0.9` inverted at 35.8 µs. Such a point has already
+//!   failed by the case's own criterion, so it is **eroded** instead of
+//!   stopping the run: it carries no stress (and so no internal force)
+//!   from then on, keeps its state for the output and the criterion, and
+//!   its particles keep their mass — element erosion as in LS-DYNA's
+//!   negative-volume and failure erosion, for points only. A point that
+//!   inverts without meeting the criterion still stops the run with the
+//!   inverted-point error, as does every inversion with
+//!   `fracture.erode_inverted = false`. `history.csv` counts the eroded
+//!   points (`eroded_points`) and the run summary reports them
+//!   (`inverted_failed_points_are_eroded_and_others_stop_the_run`).
 //! - Crack segments are extended by `5 δ` beyond each end that is not a
 //!   growing tip, so sight lines grazing a split vertex are blocked.
 //! - After a change the internal force is recomputed from the new table
@@ -228,9 +225,9 @@ pub struct FractureParameters {
     /// ~40 spacings apart.
     pub nucleation_distance_factor: Real,
     /// Erode a quadrature point that inverts (`J ≤ 0`) after it has met the
-    /// crack criterion or within `R` of a crack path, instead of stopping
-    /// the run (module doc, "erosion of inverted failed points"). Default
-    /// true; false stops the run at the first inverted point.
+    /// crack criterion, instead of stopping the run (module doc, "erosion
+    /// of inverted failed points"). Default true; false stops the run at
+    /// the first inverted point, failed or not.
     pub erode_inverted: bool,
 }
 

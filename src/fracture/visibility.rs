@@ -16,7 +16,7 @@
 //! sight line's bounding box touches: the cost per query does not grow
 //! with the number of cracks.
 
-use super::geometry::{point_segment_distance, side_allows, sight_line_blocked};
+use super::geometry::{side_allows, sight_line_blocked};
 use crate::math::{Real, Vec2};
 use crate::particles::FaceSide;
 use crate::shape::Visibility;
@@ -66,12 +66,6 @@ impl CrackSegments {
     #[inline]
     fn cell_of(cell: Real, p: &Vec2) -> (i64, i64) {
         ((p.x / cell).floor() as i64, (p.y / cell).floor() as i64)
-    }
-
-    /// Distance from `x` to the nearest segment (infinite without one). A
-    /// linear scan: for rare queries (an inverted point), not hot loops.
-    pub fn distance(&self, x: &Vec2) -> Real {
-        self.segments.iter().map(|(a, b)| point_segment_distance(a, b, x)).fold(Real::INFINITY, Real::min)
     }
 
     /// Whether any segment blocks the sight line from `x` to `p`.
