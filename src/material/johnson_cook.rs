@@ -671,7 +671,7 @@ impl JohnsonCook {
     /// kinematics (always, in the solver) it is formed on [`Block2`]s, the
     /// same arithmetic on the five entries that can be non-zero: the same
     /// bits (test `block_elastic_trial_has_the_same_bits`).
-    #[inline]
+    #[inline(always)]
     fn elastic_trial(&self, tau: &Tensor3, k: &StepKinematics) -> (Tensor3, Real) {
         if let (Some(tau), Some(d), Some(w)) =
             (Block2::from_tensor(tau), Block2::from_tensor(&k.d), Block2::from_tensor(&k.w))
