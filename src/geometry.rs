@@ -109,11 +109,10 @@ impl GeometryMode {
     /// ∂N_I/∂X_J`, plus in axisymmetry the hoop term `(P w_q)_θθ N_I / R_q`
     /// on the radial component ([RL10, Eq. (2.31)], SPEC §4).
     #[inline]
-    pub fn internal_force(self, pw: &Tensor3, n: Real, grad_n: &Vec2, x0_q: &Vec2) -> Vec2 {
-        let mut f =
-            Vec2::new(pw[(0, 0)] * grad_n.x + pw[(0, 1)] * grad_n.y, pw[(1, 0)] * grad_n.x + pw[(1, 1)] * grad_n.y);
+    pub fn internal_force(self, pw: &Block2, n: Real, grad_n: &Vec2, x0_q: &Vec2) -> Vec2 {
+        let mut f = Vec2::new(pw.xx * grad_n.x + pw.xy * grad_n.y, pw.yx * grad_n.x + pw.yy * grad_n.y);
         if self == GeometryMode::Axisymmetric {
-            f.x += pw[(2, 2)] * n / x0_q.x;
+            f.x += pw.zz * n / x0_q.x;
         }
         f
     }

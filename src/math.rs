@@ -170,6 +170,16 @@ impl Block2 {
     pub fn from_tensor(t: &Tensor3) -> Option<Block2> {
         is_block_2d(t).then(|| Block2 { xx: t[(0, 0)], xy: t[(0, 1)], yx: t[(1, 0)], yy: t[(1, 1)], zz: t[(2, 2)] })
     }
+    /// The five block entries of any tensor (those outside are dropped).
+    #[inline]
+    pub fn block_part(t: &Tensor3) -> Block2 {
+        Block2 { xx: t[(0, 0)], xy: t[(0, 1)], yx: t[(1, 0)], yy: t[(1, 1)], zz: t[(2, 2)] }
+    }
+    /// The zero tensor.
+    #[inline]
+    pub fn zeros() -> Block2 {
+        Block2 { xx: 0.0, xy: 0.0, yx: 0.0, yy: 0.0, zz: 0.0 }
+    }
     /// The full tensor, `+0` outside the block.
     #[inline]
     pub fn to_tensor(&self) -> Tensor3 {

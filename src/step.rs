@@ -457,8 +457,8 @@ impl Simulation {
                 *temp = new.temperature;
                 *dmg = new.damage;
                 *pw = match (new_tau, &k.block) {
-                    (Some(t), Some((_, f_inv))) => t.mul_transpose(f_inv).scale(*w).to_tensor(),
-                    _ => mul_2d(&new.tau, &k.f_inv.transpose()) * *w,
+                    (Some(t), Some((_, f_inv))) => t.mul_transpose(f_inv).scale(*w),
+                    _ => Block2::block_part(&(mul_2d(&new.tau, &k.f_inv.transpose()) * *w)),
                 };
                 None
             })
