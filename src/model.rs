@@ -294,9 +294,9 @@ impl Model {
     pub fn lumped_mass(&self, i: usize) -> Real {
         let mut m = 0.0;
         for j in self.gather.range(i) {
-            let (k, q) = (self.gather.entry[j] as usize, self.gather.point[j] as usize);
+            let q = self.gather.point[j] as usize;
             let rho = self.materials[self.quad.body[q] as usize].density();
-            m += rho * self.qp_shape.value[k] * self.quad.weight[q];
+            m += rho * self.gather.value[j] * self.quad.weight[q];
         }
         m
     }
@@ -313,22 +313,26 @@ impl Model {
 
     /// Physical displacement at each particle `u(X_I) = Σ_J N_J(X_I) U_J`.
     pub fn physical(&self, field: &[Vec2]) -> Vec<Vec2> {
-        (0..self.particles.len()).map(|i| self.particle_shape.interpolate(i, field)).collect()
+        (0..self.particles.len()).into_par_iter().map(|i| self.particle_shape.interpolate(i, field)).collect()
     }
 
     /// Lumped projection of a quadrature field onto the particles:
     /// `f_I = Σ_q N_I(X_q) w_q f_q / Σ_q N_I(X_q) w_q` (the same weights as
     /// the lumped mass).
-    pub fn project<T>(&self, f: impl Fn(usize) -> T) -> Vec<T>
+    ///
+    /// In parallel over the particles; each sums its own entries in fixed
+    /// order, so the result does not depend on the thread count.
+    pub fn project<T>(&self, f: impl Fn(usize) -> T + Sync) -> Vec<T>
     where
-        T: Copy + std::ops::Add<Output = T> + std::ops::Mul<Real, Output = T> + Default,
+        T: Copy + Send + std::ops::Add<Output = T> + std::ops::Mul<Real, Output = T> + Default,
     {
         (0..self.particles.len())
+            .into_par_iter()
             .map(|i| {
                 let (mut acc, mut wsum) = (T::default(), 0.0);
                 for j in self.gather.range(i) {
-                    let (k, q) = (self.gather.entry[j] as usize, self.gather.point[j] as usize);
-                    let w = self.qp_shape.value[k] * self.quad.weight[q];
+                    let q = self.gather.point[j] as usize;
+                    let w = self.gather.value[j] * self.quad.weight[q];
                     acc = acc + f(q) * w;
                     wsum += w;
                 }
