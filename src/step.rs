@@ -417,8 +417,9 @@ impl Simulation {
             .enumerate()
             .map(|(qi, (f, tau, eps_p, eps_rate, temp, dmg, pw, work, x0, w, body))| {
                 // Legend: gu = grad U, gv = grad V (2x2), uq/vq = interpolated U, V
-                // (only read in axisymmetry). The 3x3 algebra uses the block
-                // form of 2D kinematics (same bits as the general products).
+                // (only read in axisymmetry). The 3x3 algebra works on the five
+                // entries of the block form of 2D kinematics (`Block2`; same
+                // bits as the general products).
                 let (gu, gv) = tab.gradient_pair(qi, u, v);
                 let (uq, vq) = if mode.needs_point_values() {
                     (tab.interpolate(qi, u), tab.interpolate(qi, v))
