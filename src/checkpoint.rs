@@ -73,7 +73,7 @@ use crate::contact::{ContactAccumulators, ContactSystem, MasterFeature, Pairing,
 use crate::fracture::rows::Basis;
 use crate::fracture::{Crack, CrackEvent, CrackGrowth, CrackVertex, Criterion, EventKind, FractureParameters};
 use crate::material::Material;
-use crate::math::{Real, Tensor3, Vec2};
+use crate::math::{Block2, Real, Tensor3, Vec2};
 use crate::model::{BodyInfo, Gather, Model};
 use crate::particles::{FaceSide, ParticleFlags, Particles};
 use crate::quadrature::{QuadraturePoints, NO_CARRY};
@@ -645,6 +645,8 @@ fn write_payload<W: Write>(
         eroded,
     } = &m.quad;
     let eroded_bytes: Vec<u8> = eroded.iter().map(|&e| e as u8).collect();
+    // `P w` is kept as its block entries; the format stores the full tensor.
+    let pw: Vec<Tensor3> = pw.iter().map(|p| p.to_tensor()).collect();
     e.section(
         b"QUAD",
         &[
@@ -657,7 +659,7 @@ fn write_payload<W: Write>(
             Col::F64(eps_p_rate),
             Col::F64(temperature),
             Col::F64(damage),
-            Col::T3(pw),
+            Col::T3(&pw),
             Col::U32(f_carry_slot),
             Col::U8(&eroded_bytes),
         ],
@@ -1050,7 +1052,7 @@ fn restore(all: &Sections, meta: &mut Dec, case: &Case) -> Result<(Simulation, R
         eps_p_rate: d.f64s()?,
         temperature: d.f64s()?,
         damage: d.f64s()?,
-        pw: d.t3s()?,
+        pw: d.t3s()?.iter().map(Block2::block_part).collect(),
         f_carry_slot: d.u32s()?,
         eroded: d.u8s()?.into_iter().map(|b| b != 0).collect(),
         f_carry: {

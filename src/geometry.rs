@@ -6,7 +6,7 @@
 //! (index 2) is z in plane strain (`F_zz = 1`) and the hoop direction θ in
 //! axisymmetry (`F_θθ = 1 + u_r/R`, `d_θθ = v_r/r`).
 
-use crate::math::{Real, Tensor3, Vec2};
+use crate::math::{Block2, Real, Tensor3, Vec2};
 use serde::{Deserialize, Serialize};
 
 /// How a 2D section represents the 3D body.
@@ -73,15 +73,46 @@ impl GeometryMode {
         f + Tensor3::identity() * identity_part
     }
 
+    /// [`Self::deformation_gradient`] as a [`Block2`] (which it always is),
+    /// with the same bits: nalgebra's `f + I·identity_part` adds
+    /// `0·identity_part` to the off-diagonal entries, and so does this (test
+    /// `block_deformation_gradient_has_the_same_bits`).
+    #[inline]
+    pub fn deformation_gradient_2d(
+        self,
+        grad_u: &nalgebra::Matrix2<Real>,
+        u: &Vec2,
+        x0: &Vec2,
+        identity_part: Real,
+    ) -> Block2 {
+        let zz = match self {
+            GeometryMode::PlaneStrain => 0.0,
+            GeometryMode::Axisymmetric => {
+                if x0.x > 0.0 {
+                    u.x / x0.x
+                } else {
+                    grad_u[(0, 0)]
+                }
+            }
+        };
+        let off = 0.0 * identity_part;
+        Block2 {
+            xx: grad_u[(0, 0)] + identity_part,
+            xy: grad_u[(0, 1)] + off,
+            yx: grad_u[(1, 0)] + off,
+            yy: grad_u[(1, 1)] + identity_part,
+            zz: zz + identity_part,
+        }
+    }
+
     /// Force on particle `I` from quadrature point `q`: `f_i = (P w_q)_{iJ}
     /// ∂N_I/∂X_J`, plus in axisymmetry the hoop term `(P w_q)_θθ N_I / R_q`
     /// on the radial component ([RL10, Eq. (2.31)], SPEC §4).
     #[inline]
-    pub fn internal_force(self, pw: &Tensor3, n: Real, grad_n: &Vec2, x0_q: &Vec2) -> Vec2 {
-        let mut f =
-            Vec2::new(pw[(0, 0)] * grad_n.x + pw[(0, 1)] * grad_n.y, pw[(1, 0)] * grad_n.x + pw[(1, 1)] * grad_n.y);
+    pub fn internal_force(self, pw: &Block2, n: Real, grad_n: &Vec2, x0_q: &Vec2) -> Vec2 {
+        let mut f = Vec2::new(pw.xx * grad_n.x + pw.xy * grad_n.y, pw.yx * grad_n.x + pw.yy * grad_n.y);
         if self == GeometryMode::Axisymmetric {
-            f.x += pw[(2, 2)] * n / x0_q.x;
+            f.x += pw.zz * n / x0_q.x;
         }
         f
     }
@@ -110,5 +141,20 @@ mod tests {
         // on the axis the limit du_r/dR is used
         let fa = GeometryMode::Axisymmetric.deformation_gradient(&g, &Vec2::zeros(), &Vec2::new(0.0, 0.1), 1.0);
         assert!((fa[(2, 2)] - 1.01).abs() < 1e-15);
+    }
+
+    #[test]
+    fn block_deformation_gradient_has_the_same_bits() {
+        let bits = |t: &Tensor3| t.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for g in [nalgebra::Matrix2::new(0.01, -0.0, 0.0, -0.02), nalgebra::Matrix2::new(-0.0, -0.3, -0.0, 0.0)] {
+            for (u, x0) in [(Vec2::new(1e-3, 0.0), Vec2::new(0.3, 0.1)), (Vec2::new(-0.0, 2.0), Vec2::new(0.0, 0.1))] {
+                for mode in [GeometryMode::PlaneStrain, GeometryMode::Axisymmetric] {
+                    for ip in [1.0, 0.0] {
+                        let full = mode.deformation_gradient(&g, &u, &x0, ip);
+                        assert_eq!(bits(&mode.deformation_gradient_2d(&g, &u, &x0, ip).to_tensor()), bits(&full));
+                    }
+                }
+            }
+        }
     }
 }

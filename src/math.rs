@@ -36,6 +36,16 @@ pub fn von_mises(t: &Tensor3) -> Real {
     (1.5 * s.component_mul(&s).sum()).sqrt()
 }
 
+/// [`von_mises`], on the five entries of a tensor of block form
+/// ([`Block2::von_mises`], the same bits), else nalgebra's.
+#[inline]
+pub fn von_mises_2d(t: &Tensor3) -> Real {
+    match Block2::from_tensor(t) {
+        Some(b) => b.von_mises(),
+        None => von_mises(t),
+    }
+}
+
 /// Symmetric part.
 #[inline]
 pub fn sym(t: &Tensor3) -> Tensor3 {
@@ -131,6 +141,166 @@ pub fn mul_2d(a: &Tensor3, b: &Tensor3) -> Tensor3 {
     )
 }
 
+/// A tensor of block form (see [`is_block_2d`]) held by its five possibly
+/// non-zero entries: the in-plane block `xx xy / yx yy` and the
+/// out-of-plane `zz`. The hot per-point kinematics and the elastic trial
+/// stress work on these instead of nine-entry [`Tensor3`]s.
+///
+/// Every operation repeats, entry by entry, the arithmetic nalgebra does
+/// on the corresponding [`Tensor3`] — including its products with the
+/// identity's zeros (`0·s`), which can flip the sign of a zero — so that
+/// [`Block2::to_tensor`] of a result has the same bits as the [`Tensor3`]
+/// expression (test `block2_operations_match_nalgebra_bit_for_bit`). The
+/// entries outside the block are `+0` in every result, as nalgebra gives
+/// them for block-form operands and the non-negative scale factors used; the ones left out of sums (`ddot`, `von
+/// Mises`) are `±0` terms, which never change a running sum that starts at
+/// `+0` (such a sum is never `−0`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Block2 {
+    pub xx: Real,
+    pub xy: Real,
+    pub yx: Real,
+    pub yy: Real,
+    pub zz: Real,
+}
+
+impl Block2 {
+    /// The block entries of `t`, `None` unless `t` has the block form.
+    #[inline]
+    pub fn from_tensor(t: &Tensor3) -> Option<Block2> {
+        is_block_2d(t).then(|| Block2 { xx: t[(0, 0)], xy: t[(0, 1)], yx: t[(1, 0)], yy: t[(1, 1)], zz: t[(2, 2)] })
+    }
+    /// The five block entries of any tensor (those outside are dropped).
+    #[inline]
+    pub fn block_part(t: &Tensor3) -> Block2 {
+        Block2 { xx: t[(0, 0)], xy: t[(0, 1)], yx: t[(1, 0)], yy: t[(1, 1)], zz: t[(2, 2)] }
+    }
+    /// The zero tensor.
+    #[inline]
+    pub fn zeros() -> Block2 {
+        Block2 { xx: 0.0, xy: 0.0, yx: 0.0, yy: 0.0, zz: 0.0 }
+    }
+    /// The full tensor, `+0` outside the block.
+    #[inline]
+    pub fn to_tensor(&self) -> Tensor3 {
+        Tensor3::new(self.xx, self.xy, 0.0, self.yx, self.yy, 0.0, 0.0, 0.0, self.zz)
+    }
+    /// The block entries of `identity() * s` (outside the block nalgebra
+    /// has `0·s`, `−0` for `s < 0`; added to or subtracted from a block
+    /// tensor, as it is used here, those give `+0`).
+    #[inline]
+    pub fn identity_scaled(s: Real) -> Block2 {
+        Block2 { xx: s, xy: 0.0 * s, yx: 0.0 * s, yy: s, zz: s }
+    }
+    /// `self + b`.
+    #[inline]
+    pub fn add(&self, b: &Block2) -> Block2 {
+        Block2 { xx: self.xx + b.xx, xy: self.xy + b.xy, yx: self.yx + b.yx, yy: self.yy + b.yy, zz: self.zz + b.zz }
+    }
+    /// `self − b`.
+    #[inline]
+    pub fn sub(&self, b: &Block2) -> Block2 {
+        Block2 { xx: self.xx - b.xx, xy: self.xy - b.xy, yx: self.yx - b.yx, yy: self.yy - b.yy, zz: self.zz - b.zz }
+    }
+    /// `self * s` for `s ≥ 0` (a negative factor would give nalgebra's `−0`
+    /// outside the block; the solver scales by `½`, `Δt`, moduli and
+    /// weights).
+    #[inline]
+    pub fn scale(&self, s: Real) -> Block2 {
+        Block2 { xx: self.xx * s, xy: self.xy * s, yx: self.yx * s, yy: self.yy * s, zz: self.zz * s }
+    }
+    /// `tr self`, summed as nalgebra does (from `+0`, in index order).
+    #[inline]
+    pub fn trace(&self) -> Real {
+        0.0 + self.xx + self.yy + self.zz
+    }
+    /// `det self`, as [`determinant_2d`].
+    #[inline]
+    pub fn determinant(&self) -> Real {
+        self.xx * (self.yy * self.zz) - self.xy * (self.yx * self.zz)
+    }
+    /// `self⁻¹`, as [`try_inverse_2d`]; `None` if the determinant is 0.
+    #[inline]
+    pub fn try_inverse(&self) -> Option<Block2> {
+        let (m11, m12, m21, m22, m33) = (self.xx, self.xy, self.yx, self.yy, self.zz);
+        let minor_m12_m23 = m22 * m33;
+        let minor_m11_m23 = m21 * m33;
+        let det = m11 * minor_m12_m23 - m12 * minor_m11_m23;
+        if det == 0.0 {
+            return None;
+        }
+        Some(Block2 {
+            xx: minor_m12_m23 / det,
+            xy: -(m33 * m12) / det,
+            yx: -minor_m11_m23 / det,
+            yy: (m11 * m33) / det,
+            zz: (m11 * m22 - m21 * m12) / det,
+        })
+    }
+    /// `self b`, as [`mul_2d`].
+    #[inline]
+    pub fn mul(&self, b: &Block2) -> Block2 {
+        Block2 {
+            xx: self.xx * b.xx + self.xy * b.yx,
+            xy: self.xx * b.xy + self.xy * b.yy,
+            yx: self.yx * b.xx + self.yy * b.yx,
+            yy: self.yx * b.xy + self.yy * b.yy,
+            zz: self.zz * b.zz,
+        }
+    }
+    /// `self bᵀ`, as [`mul_2d`] with a transposed second factor.
+    #[inline]
+    pub fn mul_transpose(&self, b: &Block2) -> Block2 {
+        Block2 {
+            xx: self.xx * b.xx + self.xy * b.xy,
+            xy: self.xx * b.yx + self.xy * b.yy,
+            yx: self.yx * b.xx + self.yy * b.xy,
+            yy: self.yx * b.yx + self.yy * b.yy,
+            zz: self.zz * b.zz,
+        }
+    }
+    /// Symmetric part, as [`sym`].
+    #[inline]
+    pub fn sym(&self) -> Block2 {
+        Block2 {
+            xx: (self.xx + self.xx) * 0.5,
+            xy: (self.xy + self.yx) * 0.5,
+            yx: (self.yx + self.xy) * 0.5,
+            yy: (self.yy + self.yy) * 0.5,
+            zz: (self.zz + self.zz) * 0.5,
+        }
+    }
+    /// Skew-symmetric part, as [`skew`] (whose diagonal `x − x` is `0`
+    /// for finite `x` and NaN otherwise: kept, not written as `0`).
+    #[allow(clippy::eq_op)]
+    #[inline]
+    pub fn skew(&self) -> Block2 {
+        Block2 {
+            xx: (self.xx - self.xx) * 0.5,
+            xy: (self.xy - self.yx) * 0.5,
+            yx: (self.yx - self.xy) * 0.5,
+            yy: (self.yy - self.yy) * 0.5,
+            zz: (self.zz - self.zz) * 0.5,
+        }
+    }
+    /// Deviatoric part, as [`deviator`].
+    #[inline]
+    pub fn deviator(&self) -> Block2 {
+        self.sub(&Block2::identity_scaled(self.trace() / 3.0))
+    }
+    /// `self : b`, as [`ddot`] (nalgebra's column-major order).
+    #[inline]
+    pub fn ddot(&self, b: &Block2) -> Real {
+        0.0 + self.xx * b.xx + self.yx * b.yx + self.xy * b.xy + self.yy * b.yy + self.zz * b.zz
+    }
+    /// Von Mises value, as [`von_mises`].
+    #[inline]
+    pub fn von_mises(&self) -> Real {
+        let s = self.deviator();
+        (1.5 * s.ddot(&s)).sqrt()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -201,5 +371,59 @@ mod tests {
         assert_eq!(try_inverse_2d(&full), full.try_inverse());
         assert_eq!(determinant_2d(&full), full.determinant());
         assert_eq!(mul_2d(&full, &identity()), full);
+    }
+
+    /// Random block tensors with signed zeros, singular and special
+    /// entries: every [`Block2`] operation gives nalgebra's bits, and `+0`
+    /// outside the block.
+    #[test]
+    fn block2_operations_match_nalgebra_bit_for_bit() {
+        let mut seed = 5u64;
+        let mut r = move || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            let u = (seed >> 11) as Real / (1u64 << 53) as Real;
+            match seed % 13 {
+                0 => 0.0,
+                1 => -0.0,
+                2 => -1e-300 * u,
+                _ => (u - 0.5) * 4.0,
+            }
+        };
+        let bits = |t: &Tensor3| t.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for k in 0..20_000 {
+            let (mut ta, mut tb) = (Tensor3::zeros(), Tensor3::zeros());
+            for (i, j) in [(0, 0), (0, 1), (1, 0), (1, 1), (2, 2)] {
+                ta[(i, j)] = r();
+                tb[(i, j)] = r();
+            }
+            if k % 50 == 0 {
+                ta[(1, 0)] = ta[(0, 0)] * ta[(1, 1)] / ta[(0, 1)];
+            }
+            let (a, b) = (Block2::from_tensor(&ta).unwrap(), Block2::from_tensor(&tb).unwrap());
+            assert_eq!(bits(&a.to_tensor()), bits(&ta));
+            let s = r();
+            // Alone, `I s` has `0·s = −0` outside the block for `s < 0`; in
+            // a sum or difference with a block tensor those become `+0`.
+            assert_eq!(bits(&a.sub(&Block2::identity_scaled(s)).to_tensor()), bits(&(ta - identity() * s)));
+            assert_eq!(bits(&a.add(&Block2::identity_scaled(s)).to_tensor()), bits(&(ta + identity() * s)));
+            assert_eq!(bits(&a.add(&b).to_tensor()), bits(&(ta + tb)));
+            assert_eq!(bits(&a.sub(&b).to_tensor()), bits(&(ta - tb)));
+            assert_eq!(bits(&a.scale(s.abs()).to_tensor()), bits(&(ta * s.abs())));
+            assert_eq!(a.trace().to_bits(), ta.trace().to_bits());
+            assert_eq!(a.determinant().to_bits(), determinant_2d(&ta).to_bits());
+            match (a.try_inverse(), try_inverse_2d(&ta)) {
+                (Some(x), Some(y)) => assert_eq!(bits(&x.to_tensor()), bits(&y)),
+                (None, None) => {}
+                (x, y) => panic!("{x:?} vs {y:?}"),
+            }
+            assert_eq!(bits(&a.mul(&b).to_tensor()), bits(&mul_2d(&ta, &tb)));
+            assert_eq!(bits(&a.mul_transpose(&b).to_tensor()), bits(&mul_2d(&ta, &tb.transpose())));
+            assert_eq!(bits(&a.sym().to_tensor()), bits(&sym(&ta)));
+            assert_eq!(bits(&a.skew().to_tensor()), bits(&skew(&ta)));
+            assert_eq!(bits(&a.deviator().to_tensor()), bits(&deviator(&ta)));
+            assert_eq!(a.ddot(&b).to_bits(), ddot(&ta, &tb).to_bits());
+            assert_eq!(a.von_mises().to_bits(), von_mises(&ta).to_bits());
+        }
+        assert_eq!(Block2::from_tensor(&Tensor3::new(1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 10.0)), None);
     }
 }

@@ -8,6 +8,7 @@ use crate::math::{Real, Tensor3, Vec2};
 use crate::particles::{ParticleFlags, Particles};
 use crate::quadrature::QuadraturePoints;
 use crate::shape::{build_table, AllVisible, ShapeError, ShapeTable};
+use rayon::prelude::*;
 
 /// An axis-aligned box in the reference configuration, used to select
 /// particles (supports, initial-velocity regions).
@@ -105,6 +106,14 @@ pub struct Gather {
 
 impl Gather {
     /// Build from a table whose column indices are particles `0..n`.
+    ///
+    /// In parallel over blocks of particles, one per worker thread: each
+    /// block scans the table's indices and fills only its own particles'
+    /// entries, which lie in one contiguous stretch of the output. Every
+    /// particle's entries are still written in ascending entry order, so
+    /// the result does not depend on the number of blocks (test
+    /// `gather_is_the_same_for_any_number_of_threads`). It is rebuilt after
+    /// every crack split, inside the time loop.
     pub fn new(table: &ShapeTable, n: usize) -> Self {
         let mut offsets = vec![0usize; n + 1];
         for &i in &table.index {
@@ -113,21 +122,43 @@ impl Gather {
         for i in 0..n {
             offsets[i + 1] += offsets[i];
         }
-        let mut fill = offsets.clone();
-        let mut entry = vec![0u32; table.nnz()];
-        let mut point = vec![0u32; table.nnz()];
-        let mut value = vec![0.0; table.nnz()];
-        let mut grad = vec![Vec2::zeros(); table.nnz()];
-        for q in 0..table.rows() {
-            for k in table.range(q) {
-                let i = table.index[k] as usize;
-                entry[fill[i]] = k as u32;
-                point[fill[i]] = q as u32;
-                value[fill[i]] = table.value[k];
-                grad[fill[i]] = table.grad[k];
-                fill[i] += 1;
-            }
+        let nnz = table.nnz();
+        let mut entry = vec![0u32; nnz];
+        let mut point = vec![0u32; nnz];
+        let mut value = vec![0.0; nnz];
+        let mut grad = vec![Vec2::zeros(); nnz];
+        let blocks = rayon::current_num_threads().clamp(1, n.max(1));
+        let mut parts = Vec::with_capacity(blocks);
+        let (mut e, mut p, mut v, mut g) = (&mut entry[..], &mut point[..], &mut value[..], &mut grad[..]);
+        for b in 0..blocks {
+            let particles = b * n / blocks..(b + 1) * n / blocks;
+            let len = offsets[particles.end] - offsets[particles.start];
+            let (e0, e1) = std::mem::take(&mut e).split_at_mut(len);
+            let (p0, p1) = std::mem::take(&mut p).split_at_mut(len);
+            let (v0, v1) = std::mem::take(&mut v).split_at_mut(len);
+            let (g0, g1) = std::mem::take(&mut g).split_at_mut(len);
+            (e, p, v, g) = (e1, p1, v1, g1);
+            parts.push((particles, e0, p0, v0, g0));
         }
+        let offsets_ref = &offsets;
+        parts.into_par_iter().for_each(|(particles, entry, point, value, grad)| {
+            let base = offsets_ref[particles.start];
+            let mut fill: Vec<usize> = offsets_ref[particles.clone()].iter().map(|o| o - base).collect();
+            for q in 0..table.rows() {
+                for k in table.range(q) {
+                    let i = table.index[k] as usize;
+                    if !particles.contains(&i) {
+                        continue;
+                    }
+                    let slot = &mut fill[i - particles.start];
+                    entry[*slot] = k as u32;
+                    point[*slot] = q as u32;
+                    value[*slot] = table.value[k];
+                    grad[*slot] = table.grad[k];
+                    *slot += 1;
+                }
+            }
+        });
         Gather { offsets, entry, point, value, grad }
     }
     #[inline]
@@ -263,9 +294,9 @@ impl Model {
     pub fn lumped_mass(&self, i: usize) -> Real {
         let mut m = 0.0;
         for j in self.gather.range(i) {
-            let (k, q) = (self.gather.entry[j] as usize, self.gather.point[j] as usize);
+            let q = self.gather.point[j] as usize;
             let rho = self.materials[self.quad.body[q] as usize].density();
-            m += rho * self.qp_shape.value[k] * self.quad.weight[q];
+            m += rho * self.gather.value[j] * self.quad.weight[q];
         }
         m
     }
@@ -282,7 +313,7 @@ impl Model {
 
     /// Physical displacement at each particle `u(X_I) = Σ_J N_J(X_I) U_J`.
     pub fn physical(&self, field: &[Vec2]) -> Vec<Vec2> {
-        (0..self.particles.len()).map(|i| self.particle_shape.interpolate(i, field)).collect()
+        (0..self.particles.len()).into_par_iter().map(|i| self.particle_shape.interpolate(i, field)).collect()
     }
 
     /// The RK part of point `q`'s deformation gradient,
@@ -299,16 +330,20 @@ impl Model {
     /// Lumped projection of a quadrature field onto the particles:
     /// `f_I = Σ_q N_I(X_q) w_q f_q / Σ_q N_I(X_q) w_q` (the same weights as
     /// the lumped mass).
-    pub fn project<T>(&self, f: impl Fn(usize) -> T) -> Vec<T>
+    ///
+    /// In parallel over the particles; each sums its own entries in fixed
+    /// order, so the result does not depend on the thread count.
+    pub fn project<T>(&self, f: impl Fn(usize) -> T + Sync) -> Vec<T>
     where
-        T: Copy + std::ops::Add<Output = T> + std::ops::Mul<Real, Output = T> + Default,
+        T: Copy + Send + std::ops::Add<Output = T> + std::ops::Mul<Real, Output = T> + Default,
     {
         (0..self.particles.len())
+            .into_par_iter()
             .map(|i| {
                 let (mut acc, mut wsum) = (T::default(), 0.0);
                 for j in self.gather.range(i) {
-                    let (k, q) = (self.gather.entry[j] as usize, self.gather.point[j] as usize);
-                    let w = self.qp_shape.value[k] * self.quad.weight[q];
+                    let q = self.gather.point[j] as usize;
+                    let w = self.gather.value[j] * self.quad.weight[q];
                     acc = acc + f(q) * w;
                     wsum += w;
                 }
@@ -348,4 +383,44 @@ fn concat_tables(parts: Vec<ShapeTable>) -> ShapeTable {
         t.grad.extend(p.grad);
     }
     t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The transpose built in parallel blocks is the serial transpose
+    /// (particles' entries in ascending entry order) for 1, 2, 3 and 7
+    /// worker threads.
+    #[test]
+    fn gather_is_the_same_for_any_number_of_threads() {
+        let h = 1e-3;
+        let n = 9;
+        let x0: Vec<Vec2> = (0..n * n).map(|k| Vec2::new((k % n) as Real * h, (k / n) as Real * h)).collect();
+        let points: Vec<Vec2> = (0..(n - 1) * (n - 1))
+            .map(|k| Vec2::new(((k % (n - 1)) as Real + 0.4) * h, ((k / (n - 1)) as Real + 0.7) * h))
+            .collect();
+        let table = build_table(&points, &x0, &vec![2.2 * h; n * n], &vec![h * h; n * n], &AllVisible).unwrap();
+        let mut serial: Vec<Vec<u32>> = vec![Vec::new(); n * n];
+        for q in 0..table.rows() {
+            for k in table.range(q) {
+                serial[table.index[k] as usize].push(k as u32);
+            }
+        }
+        for threads in [1, 2, 3, 7] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let g = pool.install(|| Gather::new(&table, n * n));
+            for (i, entries) in serial.iter().enumerate() {
+                let r = g.range(i);
+                assert_eq!(&g.entry[r.clone()], &entries[..], "particle {i}, {threads} threads");
+                for j in r {
+                    let k = g.entry[j] as usize;
+                    assert!(table.range(g.point[j] as usize).contains(&k));
+                    assert_eq!(g.value[j].to_bits(), table.value[k].to_bits());
+                    assert_eq!(g.grad[j], table.grad[k]);
+                }
+            }
+            assert_eq!(g.offsets.last(), Some(&table.nnz()));
+        }
+    }
 }

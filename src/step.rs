@@ -4,7 +4,7 @@
 use crate::contact::{ContactError, ContactSystem, StepInput};
 use crate::fracture::{CrackGrowth, FractureError};
 use crate::material::{Constitutive, StepKinematics};
-use crate::math::{ddot, determinant_2d, mul_2d, skew, sym, try_inverse_2d, Real, Tensor3, Vec2};
+use crate::math::{ddot, mul_2d, skew, sym, try_inverse_2d, Block2, Real, Tensor3, Vec2};
 use crate::model::{constrain, Model};
 use crate::particles::ParticleFlags;
 use crate::quadrature::NO_CARRY;
@@ -425,36 +425,35 @@ impl Simulation {
                 }
                 let (x0, w, body) = (&x0s[qi], &weights[qi], &bodies[qi]);
                 // Legend: gu = grad U, gv = grad V (2x2), uq/vq = interpolated U, V
-                // (only read in axisymmetry). The 3x3 algebra uses the block
-                // form of 2D kinematics (same bits as the general products).
+                // (only read in axisymmetry). The 3x3 algebra works on the five
+                // entries of the block form of 2D kinematics (`Block2`; same
+                // bits as the general products).
                 let (gu, gv) = tab.gradient_pair(qi, u, v);
                 let (uq, vq) = if mode.needs_point_values() {
                     (tab.interpolate(qi, u), tab.interpolate(qi, v))
                 } else {
                     (Vec2::zeros(), Vec2::zeros())
                 };
-                let mut F_new = mode.deformation_gradient(&gu, &uq, x0, 1.0);
+                let F_dot = mode.deformation_gradient_2d(&gv, &vq, x0, 0.0);
+                let mut F_new = mode.deformation_gradient_2d(&gu, &uq, x0, 1.0);
                 if *carry != NO_CARRY {
                     // The jump carried over crack changes (`crate::fracture`).
-                    F_new += carried[*carry as usize];
+                    F_new = F_new.add(&Block2::block_part(&carried[*carry as usize]));
                 }
-                let F_dot = mode.deformation_gradient(&gv, &vq, x0, 0.0);
-                let F_mid = (*f + F_new) * 0.5;
-                let J = determinant_2d(&F_new);
-                let (F_mid_inv, F_inv) = match (try_inverse_2d(&F_mid), try_inverse_2d(&F_new)) {
-                    (Some(a), Some(b)) if J > 0.0 && J.is_finite() => (a, b),
+                let J = F_new.determinant();
+                let k = match PointKinematics::new(f, &F_new, &F_dot) {
+                    Some(k) if J > 0.0 && J.is_finite() => k,
                     _ if erosion.is_some_and(|p| p.point_failed(*eps_p, *dmg)) => {
                         // Inverted after failing: eroded, the run goes on.
                         *eroded = true;
                         *tau = Tensor3::zeros();
-                        *pw = Tensor3::zeros();
+                        *pw = Block2::zeros();
                         *work = 0.0;
                         return None;
                     }
                     _ => return Some((qi, J)),
                 };
-                let l = mul_2d(&F_dot, &F_mid_inv);
-                let kin = StepKinematics { d: sym(&l), w: skew(&l), dt };
+                let kin = StepKinematics { d: k.d, w: k.w, dt };
                 let old = crate::material::PointState {
                     tau: *tau,
                     eps_p: *eps_p,
@@ -464,14 +463,22 @@ impl Simulation {
                 };
                 let new = mats[*body as usize].update(&old, &kin);
                 let new = if cracking { crate::material::fractured(new) } else { new };
-                *work = 0.5 * ddot(&(old.tau + new.tau), &kin.d) * dt * w;
-                *f = F_new;
+                let (old_tau, new_tau) = (Block2::from_tensor(&old.tau), Block2::from_tensor(&new.tau));
+                let tau_d = match (old_tau, new_tau, &k.block) {
+                    (Some(a), Some(b), Some((l, _))) => a.add(&b).ddot(&l.sym()),
+                    _ => ddot(&(old.tau + new.tau), &kin.d),
+                };
+                *work = 0.5 * tau_d * dt * w;
+                *f = F_new.to_tensor();
                 *tau = new.tau;
                 *eps_p = new.eps_p;
                 *eps_rate = new.eps_p_rate;
                 *temp = new.temperature;
                 *dmg = new.damage;
-                *pw = mul_2d(&new.tau, &F_inv.transpose()) * *w;
+                *pw = match (new_tau, &k.block) {
+                    (Some(t), Some((_, f_inv))) => t.mul_transpose(f_inv).scale(*w),
+                    _ => Block2::block_part(&(mul_2d(&new.tau, &k.f_inv.transpose()) * *w)),
+                };
                 None
             })
             .find_first(|r| r.is_some())
@@ -570,6 +577,45 @@ impl Simulation {
             });
         }
         Ok(())
+    }
+}
+
+/// The kinematics of one quadrature point over a step: `d` and `w` of the
+/// mid-step velocity gradient `ℓ = Ḟ F_mid⁻¹`, `F_mid = (F_old + F_new)/2`,
+/// and `F_new⁻¹` (SPEC §2).
+#[allow(non_snake_case)]
+struct PointKinematics {
+    d: Tensor3,
+    w: Tensor3,
+    f_inv: Tensor3,
+    /// `(ℓ, F_new⁻¹)` in block form, where `F_old` has it (always, in
+    /// practice: `F` keeps the block form of 2D kinematics).
+    block: Option<(Block2, Block2)>,
+}
+
+impl PointKinematics {
+    /// `None` if `F_mid` or `F_new` is singular. Computed on [`Block2`]s
+    /// where `F_old` has the block form, else with the general products:
+    /// the same bits either way.
+    #[allow(non_snake_case)]
+    #[inline]
+    fn new(F_old: &Tensor3, F_new: &Block2, F_dot: &Block2) -> Option<PointKinematics> {
+        if let Some(F_old) = Block2::from_tensor(F_old) {
+            let F_mid_inv = F_old.add(F_new).scale(0.5).try_inverse()?;
+            let F_inv = F_new.try_inverse()?;
+            let l = F_dot.mul(&F_mid_inv);
+            return Some(PointKinematics {
+                d: l.sym().to_tensor(),
+                w: l.skew().to_tensor(),
+                f_inv: F_inv.to_tensor(),
+                block: Some((l, F_inv)),
+            });
+        }
+        let F_new = F_new.to_tensor();
+        let F_mid_inv = try_inverse_2d(&((F_old + F_new) * 0.5))?;
+        let f_inv = try_inverse_2d(&F_new)?;
+        let l = mul_2d(&F_dot.to_tensor(), &F_mid_inv);
+        Some(PointKinematics { d: sym(&l), w: skew(&l), f_inv, block: None })
     }
 }
 

@@ -421,7 +421,7 @@ impl HeatConduction {
     /// Particle temperatures of conducting bodies: capacity-weighted lumped
     /// projection of the quadrature temperatures; remember them as the start.
     fn project(&mut self, model: &mut Model) {
-        let (tab, gather, tq, wq) = (&model.qp_shape, &model.gather, &model.quad.temperature, &model.quad.weight);
+        let (gather, tq, wq) = (&model.gather, &model.quad.temperature, &model.quad.weight);
         let bodies = &self.bodies;
         let p = &mut model.particles;
         (p.temperature.par_iter_mut(), self.scratch.start.par_iter_mut(), &p.body)
@@ -433,8 +433,8 @@ impl HeatConduction {
                 }
                 let (mut acc, mut wsum) = (0.0, 0.0);
                 for j in gather.range(i) {
-                    let (k, q) = (gather.entry[j] as usize, gather.point[j] as usize);
-                    let w = tab.value[k] * wq[q];
+                    let q = gather.point[j] as usize;
+                    let w = gather.value[j] * wq[q];
                     acc += w * tq[q];
                     wsum += w;
                 }
@@ -477,7 +477,7 @@ impl HeatConduction {
     /// Per particle: `−(H T)_I / c_I = Σ_q ∇N_I · (q_q w_q) / c_I`, gathered
     /// in fixed order; and its row's Gershgorin bound.
     fn gather_pass(&mut self, model: &Model, with_bound: bool) {
-        let (tab, gather) = (&model.qp_shape, &model.gather);
+        let gather = &model.gather;
         let p = &model.particles;
         let bodies = &self.bodies;
         let s = &mut self.scratch;
@@ -492,8 +492,7 @@ impl HeatConduction {
                 let c = t.specific_heat * m;
                 let (mut r, mut bnd) = (0.0, 0.0);
                 for j in gather.range(i) {
-                    let (k, q) = (gather.entry[j] as usize, gather.point[j] as usize);
-                    let g = tab.grad[k];
+                    let (q, g) = (gather.point[j] as usize, gather.grad[j]);
                     r += g.dot(&flux[q]);
                     if with_bound {
                         bnd += kw_norm(&kw[q], &g) * row_norm[q];

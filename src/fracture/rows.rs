@@ -159,7 +159,16 @@ pub fn rebuild_rows_with_fallback(
         }
         fresh.push(row);
     }
-    let mut out = ShapeTable { offsets: Vec::with_capacity(table.offsets.len()), ..Default::default() };
+    // Sized up front: growing the columns entry by entry reallocated and
+    // copied the whole table a few times per split.
+    let nnz = table.nnz() - which.iter().map(|&r| table.range(r).len()).sum::<usize>()
+        + fresh.iter().map(|row| row.len()).sum::<usize>();
+    let mut out = ShapeTable {
+        offsets: Vec::with_capacity(table.offsets.len()),
+        index: Vec::with_capacity(nnz),
+        value: Vec::with_capacity(nnz),
+        grad: Vec::with_capacity(nnz),
+    };
     out.offsets.push(0);
     let mut next = which.iter().zip(fresh).peekable();
     for r in 0..table.rows() {
