@@ -142,7 +142,12 @@
 //!   measure. Points whose rows did not change carry nothing and keep
 //!   their bits. With the carry the same run perforates at 27.3 µs and
 //!   runs through (`deformation_gradient_is_continuous_across_crack_changes`;
-//!   the checkpoint carries `F_c`).
+//!   the checkpoint carries `F_c`). It changes every cracked run: a point
+//!   beside a new segment keeps its sheared `F` instead of the one-sided,
+//!   less-sheared interpolation of its visible neighbours, so the strain
+//!   ahead of a tip spreads wider; in the fine axisymmetric Case I with the
+//!   effective-strain criterion the ring crack now drifts outward to
+//!   r = 13.5 mm and cuts a 43 g plug (33 g before; `docs/validation.md`).
 //! - **Erosion of inverted failed points.** A crack tip advances by at
 //!   most one particle per step and only into material that meets the
 //!   criterion and is not compressed (triaxiality ≥ −1/3). Meanwhile the
@@ -157,15 +162,15 @@
 //!   with the inverted-point error, as does every inversion with
 //!   `fracture.erode_inverted = false`. `history.csv` counts the eroded
 //!   points (`eroded_points`) and the run summary reports them
-//!   (`inverted_failed_points_are_eroded_and_others_stop_the_run`). It does
-//!   not rescue the fine plane-strain Borvik Case I with the damage
-//!   criterion: there the left corner crack turned horizontal 0.7 mm under
-//!   the projectile face (5.3 µs), the projectile's corner then crushed
-//!   the material outside it, and at 35.8 µs points beside the stalled tip
-//!   with `D ≈ 0.45 < D_cr` inverted (`docs/validation.md`). Eroding every
-//!   inverted point within `R` of a crack as well was tried: the run then
-//!   stopped in the same step with a particle at 14.5 km/s, so that rule
-//!   was not kept.
+//!   (`inverted_failed_points_are_eroded_and_others_stop_the_run`). It
+//!   does not rescue the fine plane-strain Borvik rows with the damage
+//!   criterion: in both, one corner crack stalls beside material that the
+//!   projectile's corner crushes (pressures of 10–700 GPa, volume ratios
+//!   down to a few per cent), and the point that inverts (Case I at
+//!   35.8 µs, Case II at 37.0 µs) has `D < D_cr` (`docs/validation.md`).
+//!   Eroding every inverted point within `R` of a crack as well was tried
+//!   on Case I: the run then stopped in the same step with a particle at
+//!   14.5 km/s, so that rule was not kept.
 //! - Crack segments are extended by `5 δ` beyond each end that is not a
 //!   growing tip, so sight lines grazing a split vertex are blocked.
 //! - After a change the internal force is recomputed from the new table
