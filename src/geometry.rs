@@ -60,7 +60,15 @@ impl GeometryMode {
                 f[(i, j)] = grad_u[(i, j)];
             }
         }
-        f[(2, 2)] = match self {
+        f[(2, 2)] = self.out_of_plane_gradient(grad_u, u, x0);
+        f + Tensor3::identity() * identity_part
+    }
+
+    /// The out-of-plane entry of `∇u`: 0 in plane strain, the hoop strain
+    /// `u_r/R` in axisymmetry (`∂u_r/∂R` on the axis, its limit there).
+    #[inline]
+    fn out_of_plane_gradient(self, grad_u: &nalgebra::Matrix2<Real>, u: &Vec2, x0: &Vec2) -> Real {
+        match self {
             GeometryMode::PlaneStrain => 0.0,
             GeometryMode::Axisymmetric => {
                 if x0.x > 0.0 {
@@ -69,8 +77,7 @@ impl GeometryMode {
                     grad_u[(0, 0)]
                 }
             }
-        };
-        f + Tensor3::identity() * identity_part
+        }
     }
 
     /// [`Self::deformation_gradient`] as a [`Block2`] (which it always is),
@@ -85,16 +92,7 @@ impl GeometryMode {
         x0: &Vec2,
         identity_part: Real,
     ) -> Block2 {
-        let zz = match self {
-            GeometryMode::PlaneStrain => 0.0,
-            GeometryMode::Axisymmetric => {
-                if x0.x > 0.0 {
-                    u.x / x0.x
-                } else {
-                    grad_u[(0, 0)]
-                }
-            }
-        };
+        let zz = self.out_of_plane_gradient(grad_u, u, x0);
         let off = 0.0 * identity_part;
         Block2 {
             xx: grad_u[(0, 0)] + identity_part,
