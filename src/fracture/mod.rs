@@ -165,8 +165,8 @@
 //!   (`inverted_failed_points_are_eroded_and_others_stop_the_run`). It
 //!   does not rescue the fine plane-strain Borvik rows with the damage
 //!   criterion: in both, one corner crack stalls beside material that the
-//!   projectile's corner crushes (pressures of 10–700 GPa, volume ratios
-//!   down to a few per cent), and the point that inverts (Case I at
+//!   projectile's corner crushes (particle pressures from tens of GPa up
+//!   to 1.4 TPa), and the point that inverts (Case I at
 //!   35.8 µs, Case II at 37.0 µs) has `D < D_cr` (`docs/validation.md`).
 //!   Eroding every inverted point within `R` of a crack as well was tried
 //!   on Case I: the run then stopped in the same step with a particle at
