@@ -25,15 +25,20 @@ pub const BYTES_PER_PARTICLE: Real = 450.0;
 /// scratch (8 B) and the table row offset (8 B), rounded up.
 pub const BYTES_PER_QUADRATURE_POINT: Real = 320.0;
 /// Bytes per entry of a shape table: particle index (4 B), value (8 B),
-/// gradient (16 B), and for the quadrature table its gather entry (8 B).
-pub const BYTES_PER_QUADRATURE_ENTRY: Real = 36.0;
+/// gradient (16 B), and for the quadrature table its gather entry (table
+/// entry and point indices, 8 B, and its copies of the value and gradient,
+/// 24 B; [`crate::model::Gather`]).
+pub const BYTES_PER_QUADRATURE_ENTRY: Real = 60.0;
 /// See [`BYTES_PER_QUADRATURE_ENTRY`]: the particle table has no gather.
 pub const BYTES_PER_PARTICLE_ENTRY: Real = 28.0;
 /// Factor for what the builders hold while the tables are assembled
 /// (neighbour lists, per-body tables before concatenation). Measured peak
 /// resident memory of `plugsim check` (`/usr/bin/time -f %M`): 80 MB for
-/// `borvik-1-nofracture` (estimate 113 MiB), 281 MB for it with 48 layers
-/// (estimate 502 MiB); the estimate errs high, as a guard should.
+/// `borvik-1-nofracture` (estimate now 160 MiB), 281 MB for it with 48
+/// layers; a whole fine plane-strain Borvik run (cracks, output) peaked at
+/// 482 MiB (`/usr/bin/time -v`) against an estimate of 664 MiB. The
+/// estimate errs high, as a guard should (it was 467 MiB, below the run's
+/// peak, while the gather's copies of `N` and `∇N` were left out).
 pub const BUILD_OVERHEAD: Real = 1.5;
 /// Memory assumed available where `/proc/meminfo` cannot be read (other
 /// operating systems, restricted containers): 16 GiB, a typical workstation.
