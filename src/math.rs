@@ -301,6 +301,24 @@ impl Block2 {
     }
 }
 
+/// Entries for the bit-identity tests of the block form: a fixed
+/// pseudo-random stream (seeded by `seed`) uniform in `(−scale, scale)`,
+/// with `+0`, `−0` and tiny negative values (`−1e-300`) mixed in, one draw
+/// in 13 each — the values whose signs a reordered product would flip.
+#[cfg(test)]
+pub(crate) fn bit_test_entries(mut seed: u64, scale: Real) -> impl FnMut() -> Real {
+    move || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        let u = (seed >> 11) as Real / (1u64 << 53) as Real;
+        match seed % 13 {
+            0 => 0.0,
+            1 => -0.0,
+            2 => -1e-300 * u,
+            _ => (u - 0.5) * 2.0 * scale,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -378,17 +396,7 @@ mod tests {
     /// outside the block.
     #[test]
     fn block2_operations_match_nalgebra_bit_for_bit() {
-        let mut seed = 5u64;
-        let mut r = move || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            let u = (seed >> 11) as Real / (1u64 << 53) as Real;
-            match seed % 13 {
-                0 => 0.0,
-                1 => -0.0,
-                2 => -1e-300 * u,
-                _ => (u - 0.5) * 4.0,
-            }
-        };
+        let mut r = bit_test_entries(5, 2.0);
         let bits = |t: &Tensor3| t.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         for k in 0..20_000 {
             let (mut ta, mut tb) = (Tensor3::zeros(), Tensor3::zeros());

@@ -1485,16 +1485,7 @@ mod tests {
     #[test]
     fn block_elastic_trial_has_the_same_bits() {
         let m = weldox_460e();
-        let mut seed = 3u64;
-        let mut r = move || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            let u = (seed >> 11) as Real / (1u64 << 53) as Real;
-            match seed % 11 {
-                0 => 0.0,
-                1 => -0.0,
-                _ => (u - 0.5) * 2.0,
-            }
-        };
+        let mut r = crate::math::bit_test_entries(3, 1.0);
         let bits = |t: &Tensor3| t.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         for k in 0..20_000 {
             let mut block = |scale: Real| {
