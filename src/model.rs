@@ -89,7 +89,7 @@ pub struct BodyInfo {
 /// entries (and their rows) that involve it, in ascending entry order. The
 /// internal force is a gather over this list, so no two threads ever write
 /// the same particle and sums are bit-identical for any thread count.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Gather {
     /// Per-particle starts into `entry`, length `particles + 1`.
     pub offsets: Vec<usize>,
@@ -107,13 +107,12 @@ pub struct Gather {
 impl Gather {
     /// Build from a table whose column indices are particles `0..n`.
     ///
-    /// In parallel over blocks of particles, one per worker thread: each
-    /// block scans the table's indices and fills only its own particles'
-    /// entries, which lie in one contiguous stretch of the output. Every
-    /// particle's entries are still written in ascending entry order, so
-    /// the result does not depend on the number of blocks (test
-    /// `gather_is_the_same_for_any_number_of_threads`). It is rebuilt after
-    /// every crack split, inside the time loop.
+    /// In parallel over blocks of particles ([`Gather::fill`]): each block
+    /// scans the table's indices and fills only its own particles' entries.
+    /// Every particle's entries are still written in ascending entry order,
+    /// so the result does not depend on the number of blocks (test
+    /// `gather_is_the_same_for_any_number_of_threads`). A crack split
+    /// patches it instead ([`Gather::patch_into`]).
     pub fn new(table: &ShapeTable, n: usize) -> Self {
         let mut offsets = vec![0usize; n + 1];
         for &i in &table.index {
@@ -122,28 +121,9 @@ impl Gather {
         for i in 0..n {
             offsets[i + 1] += offsets[i];
         }
-        let nnz = table.nnz();
-        let mut entry = vec![0u32; nnz];
-        let mut point = vec![0u32; nnz];
-        let mut value = vec![0.0; nnz];
-        let mut grad = vec![Vec2::zeros(); nnz];
-        let blocks = rayon::current_num_threads().clamp(1, n.max(1));
-        let mut parts = Vec::with_capacity(blocks);
-        let (mut e, mut p, mut v, mut g) = (&mut entry[..], &mut point[..], &mut value[..], &mut grad[..]);
-        for b in 0..blocks {
-            let particles = b * n / blocks..(b + 1) * n / blocks;
-            let len = offsets[particles.end] - offsets[particles.start];
-            let (e0, e1) = std::mem::take(&mut e).split_at_mut(len);
-            let (p0, p1) = std::mem::take(&mut p).split_at_mut(len);
-            let (v0, v1) = std::mem::take(&mut v).split_at_mut(len);
-            let (g0, g1) = std::mem::take(&mut g).split_at_mut(len);
-            (e, p, v, g) = (e1, p1, v1, g1);
-            parts.push((particles, e0, p0, v0, g0));
-        }
-        let offsets_ref = &offsets;
-        parts.into_par_iter().for_each(|(particles, entry, point, value, grad)| {
-            let base = offsets_ref[particles.start];
-            let mut fill: Vec<usize> = offsets_ref[particles.clone()].iter().map(|o| o - base).collect();
+        let mut gather = Gather::default();
+        gather.fill(offsets, |particles, out| {
+            let mut fill: Vec<usize> = out.offsets[particles.clone()].iter().map(|o| o - out.base).collect();
             for q in 0..table.rows() {
                 for k in table.range(q) {
                     let i = table.index[k] as usize;
@@ -151,19 +131,174 @@ impl Gather {
                         continue;
                     }
                     let slot = &mut fill[i - particles.start];
-                    entry[*slot] = k as u32;
-                    point[*slot] = q as u32;
-                    value[*slot] = table.value[k];
-                    grad[*slot] = table.grad[k];
+                    out.put(*slot, k, q, table.value[k], table.grad[k]);
                     *slot += 1;
                 }
             }
         });
-        Gather { offsets, entry, point, value, grad }
+        gather
+    }
+
+    /// The transpose of `table` after its rows `changed` (ascending, no
+    /// repeats) were rebuilt, written into `out` (its allocations reused),
+    /// from `self`, the transpose of the table before, whose row starts were
+    /// `old_offsets`; `n` particles (splits append
+    /// particles, never remove them). `touched[i]` must hold for every
+    /// particle in a changed row before or after the rebuild (it may hold
+    /// for others). Equal to [`Gather::new`] of `table` (test
+    /// `patched_gather_equals_a_fresh_one`) at the cost of one streaming
+    /// copy: an untouched particle keeps its entries — point, value and
+    /// gradient copied as one block, entry indices shifted with their rows —
+    /// and a touched one keeps its entries of unchanged rows and merges in
+    /// those of the rebuilt rows, in row order. A crack split changes a few
+    /// hundred rows; rebuilding the whole transpose after each split was
+    /// most of the crack-growth stage.
+    pub fn patch_into(
+        &self,
+        old_offsets: &[usize],
+        table: &ShapeTable,
+        changed: &[usize],
+        touched: &[bool],
+        n: usize,
+        out: &mut Gather,
+    ) {
+        let old_n = self.offsets.len() - 1;
+        debug_assert!(n >= old_n && touched.len() >= n && old_offsets.len() == table.offsets.len());
+        let mut is_changed = vec![false; table.rows()];
+        for &q in changed {
+            is_changed[q] = true;
+        }
+        // How far each row's entries moved.
+        let shift: Vec<isize> =
+            table.offsets.iter().zip(old_offsets).map(|(&new, &old)| new as isize - old as isize).collect();
+        // The rebuilt rows' entries `(particle, row, entry)`, by particle and
+        // then row (the sort is stable and the rows come ascending).
+        let mut fresh: Vec<(u32, u32, u32)> =
+            changed.iter().flat_map(|&q| table.range(q).map(move |k| (table.index[k], q as u32, k as u32))).collect();
+        fresh.sort_by_key(|e| e.0);
+        let mut fresh_start = vec![0usize; n + 1];
+        for e in &fresh {
+            debug_assert!(touched[e.0 as usize]);
+            fresh_start[e.0 as usize + 1] += 1;
+        }
+        for i in 0..n {
+            fresh_start[i + 1] += fresh_start[i];
+        }
+        let old_range = |i: usize| if i < old_n { self.range(i) } else { 0..0 };
+        let kept = |i: usize| old_range(i).filter(|&j| !is_changed[self.point[j] as usize]);
+        let counts: Vec<usize> = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                if touched[i] {
+                    kept(i).count() + fresh_start[i + 1] - fresh_start[i]
+                } else {
+                    debug_assert!(kept(i).count() == old_range(i).len(), "particle {i} is in a changed row");
+                    old_range(i).len()
+                }
+            })
+            .collect();
+        let mut offsets = Vec::with_capacity(n + 1);
+        offsets.push(0);
+        for c in counts {
+            offsets.push(offsets.last().expect("starts at 0") + c);
+        }
+        let moved = |j: usize| (self.entry[j] as isize + shift[self.point[j] as usize]) as usize;
+        out.fill(offsets, |particles, out| {
+            for i in particles {
+                let mut slot = out.offsets[i] - out.base;
+                if !touched[i] {
+                    let (r, len) = (old_range(i), out.offsets[i + 1] - out.offsets[i]);
+                    out.point[slot..slot + len].copy_from_slice(&self.point[r.clone()]);
+                    out.value[slot..slot + len].copy_from_slice(&self.value[r.clone()]);
+                    out.grad[slot..slot + len].copy_from_slice(&self.grad[r.clone()]);
+                    for (e, j) in out.entry[slot..slot + len].iter_mut().zip(r) {
+                        *e = moved(j) as u32;
+                    }
+                    continue;
+                }
+                let mut old = kept(i).peekable();
+                let mut new = fresh[fresh_start[i]..fresh_start[i + 1]].iter().peekable();
+                loop {
+                    let take_old = match (old.peek(), new.peek()) {
+                        (Some(&j), Some(e)) => self.point[j] < e.1,
+                        (Some(_), None) => true,
+                        (None, Some(_)) => false,
+                        (None, None) => break,
+                    };
+                    if take_old {
+                        let j = old.next().expect("peeked");
+                        out.put(slot, moved(j), self.point[j] as usize, self.value[j], self.grad[j]);
+                    } else {
+                        let &(_, q, k) = new.next().expect("peeked");
+                        let (q, k) = (q as usize, k as usize);
+                        out.put(slot, k, q, table.value[k], table.grad[k]);
+                    }
+                    slot += 1;
+                }
+            }
+        });
+    }
+
+    /// Make `self` the transpose with row starts `offsets` (its allocations
+    /// reused), the columns filled in parallel over blocks of particles, one
+    /// per worker thread: `fill(particles, out)` writes exactly the entries
+    /// of `particles`, which lie in one contiguous stretch of the columns
+    /// (`out`, whose slot 0 is entry `out.base`). The result does not depend
+    /// on the number of blocks.
+    fn fill(&mut self, offsets: Vec<usize>, fill: impl Fn(std::ops::Range<usize>, &mut GatherBlock) + Sync) {
+        let n = offsets.len() - 1;
+        let nnz = offsets[n];
+        // Every slot is written by `fill`: resizing only sizes the columns.
+        self.entry.resize(nnz, 0);
+        self.point.resize(nnz, 0);
+        self.value.resize(nnz, 0.0);
+        self.grad.resize(nnz, Vec2::zeros());
+        self.offsets = offsets;
+        let blocks = rayon::current_num_threads().clamp(1, n.max(1));
+        let mut parts = Vec::with_capacity(blocks);
+        let (mut e, mut p, mut v, mut g) =
+            (&mut self.entry[..], &mut self.point[..], &mut self.value[..], &mut self.grad[..]);
+        for b in 0..blocks {
+            let particles = b * n / blocks..(b + 1) * n / blocks;
+            let len = self.offsets[particles.end] - self.offsets[particles.start];
+            let (e0, e1) = std::mem::take(&mut e).split_at_mut(len);
+            let (p0, p1) = std::mem::take(&mut p).split_at_mut(len);
+            let (v0, v1) = std::mem::take(&mut v).split_at_mut(len);
+            let (g0, g1) = std::mem::take(&mut g).split_at_mut(len);
+            (e, p, v, g) = (e1, p1, v1, g1);
+            parts.push((particles, e0, p0, v0, g0));
+        }
+        let offsets = &self.offsets;
+        parts.into_par_iter().for_each(|(particles, entry, point, value, grad)| {
+            let base = offsets[particles.start];
+            fill(particles, &mut GatherBlock { offsets, base, entry, point, value, grad });
+        });
     }
     #[inline]
     pub fn range(&self, i: usize) -> std::ops::Range<usize> {
         self.offsets[i]..self.offsets[i + 1]
+    }
+}
+
+/// One block's stretch of the gather columns while they are filled
+/// ([`Gather::fill`]).
+struct GatherBlock<'a> {
+    offsets: &'a [usize],
+    /// Entry index of slot 0.
+    base: usize,
+    entry: &'a mut [u32],
+    point: &'a mut [u32],
+    value: &'a mut [Real],
+    grad: &'a mut [Vec2],
+}
+
+impl GatherBlock<'_> {
+    #[inline]
+    fn put(&mut self, slot: usize, k: usize, q: usize, value: Real, grad: Vec2) {
+        self.entry[slot] = k as u32;
+        self.point[slot] = q as u32;
+        self.value[slot] = value;
+        self.grad[slot] = grad;
     }
 }
 
@@ -388,6 +523,64 @@ fn concat_tables(parts: Vec<ShapeTable>) -> ShapeTable {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Patching the transpose after some rows changed length and content,
+    /// and new particles appeared in them, gives exactly the transpose built
+    /// afresh, for 1, 2 and 3 worker threads, including the entry indices
+    /// of the unchanged rows, which shift with the rows before them.
+    #[test]
+    fn patched_gather_equals_a_fresh_one() {
+        let h = 1e-3;
+        let n = 9;
+        let x0: Vec<Vec2> = (0..n * n).map(|k| Vec2::new((k % n) as Real * h, (k / n) as Real * h)).collect();
+        let points: Vec<Vec2> = (0..(n - 1) * (n - 1))
+            .map(|k| Vec2::new(((k % (n - 1)) as Real + 0.4) * h, ((k / (n - 1)) as Real + 0.7) * h))
+            .collect();
+        let old = build_table(&points, &x0, &vec![2.2 * h; n * n], &vec![h * h; n * n], &AllVisible).unwrap();
+        // Rebuilt rows: every third entry dropped, one or two new particles
+        // (indices n², n² + 1) added; the first and the last row among them.
+        let changed: Vec<usize> = vec![0, 5, 6, 20, 33, old.rows() - 1];
+        let mut new = ShapeTable { offsets: vec![0], ..Default::default() };
+        for q in 0..old.rows() {
+            let mut row: Vec<(u32, Real, Vec2)> =
+                old.range(q).map(|k| (old.index[k], old.value[k], old.grad[k])).collect();
+            if changed.contains(&q) {
+                row = row.into_iter().enumerate().filter(|(m, _)| m % 3 != 1).map(|(_, e)| e).collect();
+                for extra in 0..1 + q % 2 {
+                    row.push(((n * n + extra) as u32, 0.01 * q as Real, Vec2::new(q as Real, -(extra as Real))));
+                }
+                for e in row.iter_mut() {
+                    e.1 *= 1.5;
+                }
+            }
+            for (i, v, g) in row {
+                new.index.push(i);
+                new.value.push(v);
+                new.grad.push(g);
+            }
+            new.offsets.push(new.index.len());
+        }
+        let mut touched = vec![false; n * n + 2];
+        for &q in &changed {
+            for &i in old.index[old.range(q)].iter().chain(&new.index[new.range(q)]) {
+                touched[i as usize] = true;
+            }
+        }
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let (fresh, patched) = pool.install(|| {
+                let before = Gather::new(&old, n * n);
+                {
+                    // `out` starts with stale contents of another size: every slot is rewritten.
+                    let mut out = Gather::new(&old, n * n);
+                    before.patch_into(&old.offsets, &new, &changed, &touched, n * n + 2, &mut out);
+                    (Gather::new(&new, n * n + 2), out)
+                }
+            });
+            assert_eq!(patched, fresh, "{threads} threads");
+            assert!(patched.value.iter().zip(&fresh.value).all(|(a, b)| a.to_bits() == b.to_bits()));
+        }
+    }
 
     /// The transpose built in parallel blocks is the serial transpose
     /// (particles' entries in ascending entry order) for 1, 2, 3 and 7

@@ -15,6 +15,8 @@ use crate::math::{Real, Tensor3, Vec2};
 use crate::model::{Gather, Model};
 use crate::neighbors::CellGrid;
 use crate::particles::{FaceSide, ParticleFlags};
+use crate::shape::ShapeTable;
+use rayon::prelude::*;
 use std::collections::BTreeMap;
 
 /// Crack segments are extended by this many offsets `δ` beyond each end
@@ -187,6 +189,19 @@ pub struct CrackGrowth {
     pub reduced_quadrature_rows: BTreeMap<usize, Basis>,
     /// Particle rows built with a reduced basis.
     pub reduced_particle_rows: BTreeMap<usize, Basis>,
+    /// Buffers that every local rebuild fills and swaps with the model's
+    /// tables: the tables are rewritten after each split, and writing them
+    /// into fresh allocations (page faults on tens of MB) took longer than
+    /// the copying itself.
+    spare: Spare,
+}
+
+/// See [`CrackGrowth::spare`].
+#[derive(Clone, Debug, Default)]
+struct Spare {
+    gather: Gather,
+    qp_shape: ShapeTable,
+    particle_shape: ShapeTable,
 }
 
 /// Scratch of the failed-zone search of one nucleation stage.
@@ -233,6 +248,7 @@ impl CrackGrowth {
             grid: None,
             reduced_quadrature_rows: BTreeMap::new(),
             reduced_particle_rows: BTreeMap::new(),
+            spare: Spare::default(),
         }
     }
 
@@ -256,6 +272,7 @@ impl CrackGrowth {
             grid: None,
             reduced_quadrature_rows,
             reduced_particle_rows,
+            spare: Spare::default(),
         };
         growth.refresh_segments(model);
         growth
@@ -281,8 +298,8 @@ impl CrackGrowth {
         };
         let (mut acc, mut wsum) = (0.0, 0.0);
         for j in model.gather.range(i) {
-            let (k, q) = (model.gather.entry[j] as usize, model.gather.point[j] as usize);
-            let w = model.qp_shape.value[k] * model.quad.weight[q];
+            let q = model.gather.point[j] as usize;
+            let w = model.gather.value[j] * model.quad.weight[q];
             acc += w * col[q];
             wsum += w;
         }
@@ -299,8 +316,8 @@ impl CrackGrowth {
     pub fn triaxiality(&self, model: &Model, i: usize) -> Real {
         let (mut m, mut e) = (0.0, 0.0);
         for j in model.gather.range(i) {
-            let (k, q) = (model.gather.entry[j] as usize, model.gather.point[j] as usize);
-            let w = model.qp_shape.value[k] * model.quad.weight[q];
+            let q = model.gather.point[j] as usize;
+            let w = model.gather.value[j] * model.quad.weight[q];
             m += w * crate::math::mean_stress(&model.quad.tau[q]);
             e += w * crate::math::von_mises(&model.quad.tau[q]);
         }
@@ -485,7 +502,10 @@ impl CrackGrowth {
         time: Real,
         step: u64,
     ) -> Result<Vec<usize>, FractureError> {
+        // In parallel (the scan visits every surface particle each step);
+        // the collected order is the index order either way.
         let mut cores: Vec<(Real, usize)> = (0..model.particles.len())
+            .into_par_iter()
             .filter(|&i| {
                 let f = model.particles.flags[i];
                 // The axis is a boundary of the r-z section but no surface
@@ -792,8 +812,28 @@ impl CrackGrowth {
         let vis = CrackVisibility { segments: &self.segments, x0: &p.x0, face_side: &p.face_side };
         let mut qp_shape = std::mem::take(&mut model.qp_shape);
         let mut particle_shape = std::mem::take(&mut model.particle_shape);
-        let r1 = rebuild_rows_with_fallback(&mut qp_shape, &rows_q, &model.quad.x0, &p.x0, &p.support, &p.volume, &vis);
-        let r2 = rebuild_rows_with_fallback(&mut particle_shape, &rows_p, &p.x0, &p.x0, &p.support, &p.volume, &vis);
+        let spare = &mut self.spare;
+        let (qx, px) = (&model.quad.x0, &p.x0);
+        let r1 = rebuild_rows_with_fallback(
+            &mut qp_shape,
+            &mut spare.qp_shape,
+            &rows_q,
+            qx,
+            px,
+            &p.support,
+            &p.volume,
+            &vis,
+        );
+        let r2 = rebuild_rows_with_fallback(
+            &mut particle_shape,
+            &mut spare.particle_shape,
+            &rows_p,
+            px,
+            px,
+            &p.support,
+            &p.volume,
+            &vis,
+        );
         model.qp_shape = qp_shape;
         model.particle_shape = particle_shape;
         for (rows, reduced, map) in
@@ -815,7 +855,11 @@ impl CrackGrowth {
                 model.quad.add_f_carry(q, &(before - after));
             }
         }
-        model.gather = Gather::new(&model.qp_shape, n);
+        // The table before the rebuild is now the spare one (its row starts
+        // place the old gather's entries).
+        let spare = &mut self.spare;
+        model.gather.patch_into(&spare.qp_shape.offsets, &model.qp_shape, &rows_q, &touched, n, &mut spare.gather);
+        std::mem::swap(&mut model.gather, &mut spare.gather);
         let touched: Vec<usize> = (0..n).filter(|&i| touched[i]).collect();
         let before: Real = touched.iter().map(|&i| model.particles.mass[i]).sum();
         let mut floored = Vec::new();

@@ -138,9 +138,13 @@ pub fn row_with_fallback(
 
 /// Recompute rows `which` (ascending, unique) of `table` at `points`,
 /// keeping every other row; returns the rows that needed a reduced basis,
-/// with that basis.
+/// with that basis. The new table is written into `spare` (its
+/// allocations reused) and swapped with `table`: `spare` then holds the
+/// table as it was. On an error `table` is unchanged.
+#[allow(clippy::too_many_arguments)]
 pub fn rebuild_rows_with_fallback(
     table: &mut ShapeTable,
+    spare: &mut ShapeTable,
     which: &[usize],
     points: &[Vec2],
     x0: &[Vec2],
@@ -163,12 +167,15 @@ pub fn rebuild_rows_with_fallback(
     // copied the whole table a few times per split.
     let nnz = table.nnz() - which.iter().map(|&r| table.range(r).len()).sum::<usize>()
         + fresh.iter().map(|row| row.len()).sum::<usize>();
-    let mut out = ShapeTable {
-        offsets: Vec::with_capacity(table.offsets.len()),
-        index: Vec::with_capacity(nnz),
-        value: Vec::with_capacity(nnz),
-        grad: Vec::with_capacity(nnz),
-    };
+    let out = spare;
+    out.offsets.clear();
+    out.index.clear();
+    out.value.clear();
+    out.grad.clear();
+    out.offsets.reserve(table.offsets.len());
+    out.index.reserve(nnz);
+    out.value.reserve(nnz);
+    out.grad.reserve(nnz);
     out.offsets.push(0);
     let mut next = which.iter().zip(fresh).peekable();
     for r in 0..table.rows() {
@@ -190,7 +197,7 @@ pub fn rebuild_rows_with_fallback(
         }
         out.offsets.push(out.index.len());
     }
-    *table = out;
+    std::mem::swap(table, out);
     Ok(reduced)
 }
 
@@ -213,7 +220,9 @@ mod tests {
         let pts = vec![Vec2::new(3.3 * h, 2.7 * h), Vec2::new(0.1 * h, 0.2 * h)];
         let reference = build_table(&pts, &x0, &a, &v, &AllVisible).unwrap();
         let mut t = reference.clone();
-        let reduced = rebuild_rows_with_fallback(&mut t, &[0, 1], &pts, &x0, &a, &v, &AllVisible).unwrap();
+        let reduced =
+            rebuild_rows_with_fallback(&mut t, &mut ShapeTable::default(), &[0, 1], &pts, &x0, &a, &v, &AllVisible)
+                .unwrap();
         assert!(reduced.is_empty());
         for k in 0..t.nnz() {
             assert_eq!(t.index[k], reference.index[k]);
