@@ -18,6 +18,7 @@ use crate::neighbors::SupportSearch;
 use crate::shape::rk::MAX_MOMENT_CONDITION;
 use crate::shape::{ShapeError, ShapeTable, Visibility};
 use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
 
 /// One table row: `(particle, N, ∇N)` per visible particle.
 pub type Row = Vec<(u32, Real, Vec2)>;
@@ -153,11 +154,14 @@ pub fn rebuild_rows_with_fallback(
     vis: &dyn Visibility,
 ) -> Result<Vec<(usize, Basis)>, ShapeError> {
     let search = SupportSearch::new(x0, support);
-    let mut cand = Vec::new();
+    // Rows are independent: built in parallel, collected in `which` order.
+    let built: Vec<(Row, Basis)> = which
+        .par_iter()
+        .map_init(Vec::new, |cand, &r| row_with_fallback(r, &points[r], &search, x0, support, volume, vis, cand))
+        .collect::<Result<_, _>>()?;
     let mut fresh = Vec::with_capacity(which.len());
     let mut reduced = Vec::new();
-    for &r in which {
-        let (row, basis) = row_with_fallback(r, &points[r], &search, x0, support, volume, vis, &mut cand)?;
+    for (&r, (row, basis)) in which.iter().zip(built) {
         if basis != Basis::Bilinear {
             reduced.push((r, basis));
         }
