@@ -645,16 +645,18 @@ fn write_payload<W: Write>(
         eroded,
     } = &m.quad;
     let eroded_bytes: Vec<u8> = eroded.iter().map(|&e| e as u8).collect();
-    // `P w` is kept as its block entries; the format stores the full tensor.
-    let pw: Vec<Tensor3> = pw.iter().map(|p| p.to_tensor()).collect();
+    // `F`, `τ` and `P w` are kept as their block entries; the format stores
+    // the full tensors.
+    let full = |c: &[Block2]| -> Vec<Tensor3> { c.iter().map(Block2::to_tensor).collect() };
+    let (f, tau, pw) = (full(f), full(tau), full(pw));
     e.section(
         b"QUAD",
         &[
             Col::V2(x0),
             Col::F64(weight),
             Col::U32(body),
-            Col::T3(f),
-            Col::T3(tau),
+            Col::T3(&f),
+            Col::T3(&tau),
             Col::F64(eps_p),
             Col::F64(eps_p_rate),
             Col::F64(temperature),
@@ -1046,8 +1048,8 @@ fn restore(all: &Sections, meta: &mut Dec, case: &Case) -> Result<(Simulation, R
         x0: d.v2s()?,
         weight: d.f64s()?,
         body: d.u32s()?,
-        f: d.t3s()?,
-        tau: d.t3s()?,
+        f: d.t3s()?.iter().map(Block2::block_part).collect(),
+        tau: d.t3s()?.iter().map(Block2::block_part).collect(),
         eps_p: d.f64s()?,
         eps_p_rate: d.f64s()?,
         temperature: d.f64s()?,

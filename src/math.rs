@@ -175,6 +175,11 @@ impl Block2 {
     pub fn block_part(t: &Tensor3) -> Block2 {
         Block2 { xx: t[(0, 0)], xy: t[(0, 1)], yx: t[(1, 0)], yy: t[(1, 1)], zz: t[(2, 2)] }
     }
+    /// Whether every entry is finite.
+    #[inline]
+    pub fn is_finite(&self) -> bool {
+        self.xx.is_finite() && self.xy.is_finite() && self.yx.is_finite() && self.yy.is_finite() && self.zz.is_finite()
+    }
     /// The zero tensor.
     #[inline]
     pub fn zeros() -> Block2 {

@@ -361,7 +361,7 @@ pub fn particle_piece(model: &Model, fields: &[String]) -> VtuPiece {
     let points = (0..p.len()).map(|i| v3(&(p.x0[i] + u[i]))).collect();
     let mut piece = VtuPiece::point_cloud(points);
     let q = &model.quad;
-    let cauchy = |k: usize| q.tau[k] / q.f[k].determinant();
+    let cauchy = |k: usize| q.tau[k].to_tensor() / q.f[k].determinant();
     let want = |name: &str| fields.iter().any(|f| f == name);
     if want("displacement") {
         piece = piece.with_point_data(DataArray::vectors("displacement", &u.iter().map(v3).collect::<Vec<_>>()));
@@ -443,7 +443,7 @@ pub fn field_plot(sim: &Simulation, field: &str, window: Option<[Real; 4]>) -> O
     let q = &m.quad;
     let (values, label): (Vec<Real>, &str) = match field {
         "effective_stress" => {
-            (m.project(|k| von_mises(&(q.tau[k] / q.f[k].determinant())) * 1e-6), "effective stress (MPa)")
+            (m.project(|k| von_mises(&(q.tau[k].to_tensor() / q.f[k].determinant())) * 1e-6), "effective stress (MPa)")
         }
         "temperature" => (m.project(|k| q.temperature[k]), "temperature (K)"),
         "plastic_strain" => (m.project(|k| q.eps_p[k]), "effective plastic strain"),

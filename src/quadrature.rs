@@ -14,10 +14,14 @@ pub struct QuadraturePoints {
     pub weight: Vec<Real>,
     /// Body index (selects the material).
     pub body: Vec<u32>,
-    /// Current deformation gradient `F`.
-    pub f: Vec<Tensor3>,
-    /// Kirchhoff stress `τ`, Pa.
-    pub tau: Vec<Tensor3>,
+    /// Current deformation gradient `F`, in the block form of 2D kinematics
+    /// (SPEC §2: no out-of-plane shear; [`Block2`], 40 bytes a point
+    /// instead of 72, which the material sweep reads and writes every step).
+    pub f: Vec<Block2>,
+    /// Kirchhoff stress `τ`, Pa, in block form like `F` (the material models
+    /// keep it: their updates of a block-form stress under block-form
+    /// kinematics are block-form).
+    pub tau: Vec<Block2>,
     /// Equivalent plastic strain.
     pub eps_p: Vec<Real>,
     /// Equivalent plastic strain rate, 1/s.
@@ -61,8 +65,8 @@ impl QuadraturePoints {
         self.x0.push(x0);
         self.weight.push(weight);
         self.body.push(body);
-        self.f.push(Tensor3::identity());
-        self.tau.push(s.tau);
+        self.f.push(Block2::identity_scaled(1.0));
+        self.tau.push(Block2::block_part(&s.tau));
         self.eps_p.push(s.eps_p);
         self.eps_p_rate.push(s.eps_p_rate);
         self.temperature.push(s.temperature);
@@ -95,7 +99,7 @@ impl QuadraturePoints {
     #[inline]
     pub fn state(&self, q: usize) -> PointState {
         PointState {
-            tau: self.tau[q],
+            tau: self.tau[q].to_tensor(),
             eps_p: self.eps_p[q],
             eps_p_rate: self.eps_p_rate[q],
             temperature: self.temperature[q],

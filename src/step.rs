@@ -4,7 +4,7 @@
 use crate::contact::{ContactError, ContactSystem, StepInput};
 use crate::fracture::{CrackGrowth, FractureError};
 use crate::material::{Constitutive, StepKinematics};
-use crate::math::{ddot, mul_2d, skew, sym, try_inverse_2d, Block2, Real, Tensor3, Vec2};
+use crate::math::{is_block_2d, Block2, Real, Tensor3, Vec2};
 use crate::model::{constrain, Model};
 use crate::particles::ParticleFlags;
 use crate::quadrature::NO_CARRY;
@@ -446,7 +446,7 @@ impl Simulation {
                     _ if erosion.is_some_and(|p| p.point_failed(*eps_p, *dmg)) => {
                         // Inverted after failing: eroded, the run goes on.
                         *eroded = true;
-                        *tau = Tensor3::zeros();
+                        *tau = Block2::zeros();
                         *pw = Block2::zeros();
                         *work = 0.0;
                         return None;
@@ -455,7 +455,7 @@ impl Simulation {
                 };
                 let kin = StepKinematics { d: k.d, w: k.w, dt };
                 let old = crate::material::PointState {
-                    tau: *tau,
+                    tau: tau.to_tensor(),
                     eps_p: *eps_p,
                     eps_p_rate: *eps_rate,
                     temperature: *temp,
@@ -463,22 +463,18 @@ impl Simulation {
                 };
                 let new = mats[*body as usize].update(&old, &kin);
                 let new = if cracking { crate::material::fractured(new) } else { new };
-                let (old_tau, new_tau) = (Block2::from_tensor(&old.tau), Block2::from_tensor(&new.tau));
-                let tau_d = match (old_tau, new_tau, &k.block) {
-                    (Some(a), Some(b), Some((l, _))) => a.add(&b).ddot(&l.sym()),
-                    _ => ddot(&(old.tau + new.tau), &kin.d),
-                };
-                *work = 0.5 * tau_d * dt * w;
-                *f = F_new.to_tensor();
-                *tau = new.tau;
+                // Block-form kinematics keep a block-form stress (the models'
+                // updates are sums and block products of `τ`, `d` and `w`).
+                debug_assert!(is_block_2d(&new.tau), "material update left the block form at point {qi}");
+                let new_tau = Block2::block_part(&new.tau);
+                *work = 0.5 * tau.add(&new_tau).ddot(&k.l.sym()) * dt * w;
+                *f = F_new;
+                *tau = new_tau;
                 *eps_p = new.eps_p;
                 *eps_rate = new.eps_p_rate;
                 *temp = new.temperature;
                 *dmg = new.damage;
-                *pw = match (new_tau, &k.block) {
-                    (Some(t), Some((_, f_inv))) => t.mul_transpose(f_inv).scale(*w),
-                    _ => Block2::block_part(&(mul_2d(&new.tau, &k.f_inv.transpose()) * *w)),
-                };
+                *pw = new_tau.mul_transpose(&k.f_inv).scale(*w);
                 None
             })
             .find_first(|r| r.is_some())
@@ -553,7 +549,7 @@ impl Simulation {
         if healthy && scalars_ok {
             return Ok(());
         }
-        if let Some(q) = self.model.quad.tau.par_iter().position_first(|t: &Tensor3| !t.iter().all(|x| x.is_finite())) {
+        if let Some(q) = self.model.quad.tau.par_iter().position_first(|t| !t.is_finite()) {
             return Err(SolverError::NonFinite { field: "stress", location: "quadrature point", index: q, step, time });
         }
         if let Some(k) = (0..q.len()).into_par_iter().position_first(|k| scalars.iter().any(|(_, c)| !c[k].is_finite()))
@@ -582,40 +578,26 @@ impl Simulation {
 
 /// The kinematics of one quadrature point over a step: `d` and `w` of the
 /// mid-step velocity gradient `ℓ = Ḟ F_mid⁻¹`, `F_mid = (F_old + F_new)/2`,
-/// and `F_new⁻¹` (SPEC §2).
+/// and `F_new⁻¹` (SPEC §2), on the five entries of the block form of 2D
+/// kinematics ([`Block2`]: the same bits as nalgebra's 3×3 products).
 #[allow(non_snake_case)]
 struct PointKinematics {
+    /// `d`, `w` as the material models take them.
     d: Tensor3,
     w: Tensor3,
-    f_inv: Tensor3,
-    /// `(ℓ, F_new⁻¹)` in block form, where `F_old` has it (always, in
-    /// practice: `F` keeps the block form of 2D kinematics).
-    block: Option<(Block2, Block2)>,
+    l: Block2,
+    f_inv: Block2,
 }
 
 impl PointKinematics {
-    /// `None` if `F_mid` or `F_new` is singular. Computed on [`Block2`]s
-    /// where `F_old` has the block form, else with the general products:
-    /// the same bits either way.
+    /// `None` if `F_mid` or `F_new` is singular.
     #[allow(non_snake_case)]
     #[inline]
-    fn new(F_old: &Tensor3, F_new: &Block2, F_dot: &Block2) -> Option<PointKinematics> {
-        if let Some(F_old) = Block2::from_tensor(F_old) {
-            let F_mid_inv = F_old.add(F_new).scale(0.5).try_inverse()?;
-            let F_inv = F_new.try_inverse()?;
-            let l = F_dot.mul(&F_mid_inv);
-            return Some(PointKinematics {
-                d: l.sym().to_tensor(),
-                w: l.skew().to_tensor(),
-                f_inv: F_inv.to_tensor(),
-                block: Some((l, F_inv)),
-            });
-        }
-        let F_new = F_new.to_tensor();
-        let F_mid_inv = try_inverse_2d(&((F_old + F_new) * 0.5))?;
-        let f_inv = try_inverse_2d(&F_new)?;
-        let l = mul_2d(&F_dot.to_tensor(), &F_mid_inv);
-        Some(PointKinematics { d: sym(&l), w: skew(&l), f_inv, block: None })
+    fn new(F_old: &Block2, F_new: &Block2, F_dot: &Block2) -> Option<PointKinematics> {
+        let F_mid_inv = F_old.add(F_new).scale(0.5).try_inverse()?;
+        let f_inv = F_new.try_inverse()?;
+        let l = F_dot.mul(&F_mid_inv);
+        Some(PointKinematics { d: l.sym().to_tensor(), w: l.skew().to_tensor(), l, f_inv })
     }
 }
 

@@ -403,7 +403,7 @@ impl HeatConduction {
             .map(|(qi, (kw, f, w, b))| {
                 match bodies.get(*b as usize).and_then(|t| t.as_ref()) {
                     None => *kw = Matrix2::zeros(),
-                    Some(t) => match reference_conductivity(f, t.conductivity) {
+                    Some(t) => match reference_conductivity(&f.to_tensor(), t.conductivity) {
                         Some(k) => *kw = k * *w,
                         None => return Some((qi, f.determinant())),
                     },
@@ -614,7 +614,7 @@ mod tests {
         let mut a = vec![vec![0.0; n]; n];
         let tab = &m.qp_shape;
         for q in 0..m.quad.len() {
-            let k = reference_conductivity(&m.quad.f[q], 1.0).unwrap() * m.quad.weight[q];
+            let k = reference_conductivity(&m.quad.f[q].to_tensor(), 1.0).unwrap() * m.quad.weight[q];
             let kappa = heat.bodies[m.quad.body[q] as usize].unwrap().conductivity;
             for a_ in tab.range(q) {
                 for b_ in tab.range(q) {
@@ -694,8 +694,8 @@ mod tests {
         graded.fine_half_width = 0.002;
         let mut sheared = model(GeometryMode::PlaneStrain, grid(9, 6, 1e-3), 10.0);
         for f in sheared.quad.f.iter_mut() {
-            f[(0, 1)] = 0.5;
-            f[(1, 1)] = 0.8;
+            f.xy = 0.5;
+            f.yy = 0.8;
         }
         let cases = [
             model(GeometryMode::PlaneStrain, grid(10, 6, 1e-3), 10.0),
@@ -759,8 +759,8 @@ mod tests {
             for stage in 0..3 {
                 if stage == 1 {
                     for f in m.quad.f.iter_mut() {
-                        f[(0, 1)] = 0.7;
-                        f[(1, 1)] = 0.6;
+                        f.xy = 0.7;
+                        f.yy = 0.6;
                     }
                 }
                 if stage == 2 {

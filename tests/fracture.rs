@@ -13,7 +13,7 @@ use plugsim::fracture::rows::Basis;
 use plugsim::fracture::{CrackGrowth, Criterion, EventKind, FractureParameters};
 use plugsim::geometry::GeometryMode;
 use plugsim::material::{Elastic, Material};
-use plugsim::math::{Real, Vec2};
+use plugsim::math::{Block2, Real, Vec2};
 use plugsim::model::{BodySetup, Model};
 use plugsim::particles::ParticleFlags;
 use plugsim::shape::ShapeTable;
@@ -300,7 +300,7 @@ fn no_crack_nucleates_in_compression() {
         let shear = nalgebra::Matrix3::new(0.0, 1e8, 0.0, 1e8, 0.0, 0.0, 0.0, 0.0, 0.0);
         for q in 0..m.quad.len() {
             // von Mises of the shear part: sqrt(3) 1e8
-            m.quad.tau[q] = shear + nalgebra::Matrix3::identity() * (mean * 3f64.sqrt() * 1e8);
+            m.quad.tau[q] = Block2::block_part(&(shear + nalgebra::Matrix3::identity() * (mean * 3f64.sqrt() * 1e8)));
         }
         let mut g = CrackGrowth::new(params(Criterion::EffectiveStrain));
         drive(&mut m, &mut g, 2);
@@ -318,7 +318,7 @@ fn no_crack_nucleates_in_compression() {
         for q in 0..m.quad.len() {
             let below = m.quad.x0[q].y < top - 3.5 * H;
             let p = if below { mean } else { 0.0 };
-            m.quad.tau[q] = shear + nalgebra::Matrix3::identity() * (p * 3f64.sqrt() * 1e8);
+            m.quad.tau[q] = Block2::block_part(&(shear + nalgebra::Matrix3::identity() * (p * 3f64.sqrt() * 1e8)));
         }
         let mut g = CrackGrowth::new(params(Criterion::EffectiveStrain));
         let start = [id(&m, 10, ny - 1), id(&m, 10, ny - 2)];
@@ -404,7 +404,7 @@ fn crack_faces_are_traction_free_under_tension() {
             .collect();
         (sim.model, near)
     };
-    let sigma_yy = |m: &Model, q: usize| m.quad.tau[q][(1, 1)] / m.quad.f[q].determinant();
+    let sigma_yy = |m: &Model, q: usize| m.quad.tau[q].yy / m.quad.f[q].determinant();
     let (intact, near) = run(false);
     let (cracked, near_c) = run(true);
     assert_eq!(near, near_c);
@@ -637,7 +637,7 @@ fn deformation_gradient_is_continuous_across_crack_changes() {
     }
     // The state after a material update: stored F from the current rows.
     for q in 0..m.quad.len() {
-        m.quad.f[q] = m.shape_deformation_gradient(q);
+        m.quad.f[q] = Block2::block_part(&m.shape_deformation_gradient(q));
     }
     let mut g = CrackGrowth::new(params(Criterion::EffectiveStrain));
     let mut largest_jump: Real = 0.0;
@@ -711,7 +711,7 @@ fn inverted_failed_points_are_eroded_and_others_stop_the_run() {
     assert!(!eroded.is_empty(), "some points inverted and were eroded");
     for &k in &eroded {
         assert!((q.x0[k] - centre).norm() < 3.5 * H, "only failed points erode: {k} at {:?}", q.x0[k]);
-        assert_eq!(q.tau[k], plugsim::math::Tensor3::zeros());
+        assert_eq!(q.tau[k], Block2::zeros());
         assert_eq!(q.pw[k].to_tensor(), plugsim::math::Tensor3::zeros());
     }
     // Eroded for good; nothing else inverts; the forces stay finite.
@@ -719,7 +719,7 @@ fn inverted_failed_points_are_eroded_and_others_stop_the_run() {
         sim.step().unwrap();
     }
     let q = &sim.model.quad;
-    assert!(eroded.iter().all(|&k| q.eroded[k] && q.tau[k] == plugsim::math::Tensor3::zeros()));
+    assert!(eroded.iter().all(|&k| q.eroded[k] && q.tau[k] == Block2::zeros()));
     assert!(sim.model.particles.f_int.iter().all(|f| f.x.is_finite() && f.y.is_finite()));
     // Erosion removes stress, not mass: the free plate keeps its momentum
     // (internal forces sum to zero with or without the eroded points).

@@ -318,8 +318,9 @@ impl CrackGrowth {
         for j in model.gather.range(i) {
             let q = model.gather.point[j] as usize;
             let w = model.gather.value[j] * model.quad.weight[q];
-            m += w * crate::math::mean_stress(&model.quad.tau[q]);
-            e += w * crate::math::von_mises(&model.quad.tau[q]);
+            let tau = &model.quad.tau[q];
+            m += w * (tau.trace() / 3.0);
+            e += w * tau.von_mises();
         }
         if e > 0.0 {
             m / e
