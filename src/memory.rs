@@ -62,13 +62,16 @@ pub struct Footprint {
 }
 
 impl Footprint {
-    /// Estimated peak memory of building and running the model, bytes.
+    /// Estimated peak memory of building and running the model, bytes: the
+    /// larger of the build (the model times [`BUILD_OVERHEAD`]) and the run
+    /// with cracks, which holds a spare copy of the tables and the gather
+    /// (crack growth rewrites them into it after each split,
+    /// `crate::fracture::growth`).
     pub fn bytes(&self) -> Real {
-        BUILD_OVERHEAD
-            * (self.particles * BYTES_PER_PARTICLE
-                + self.quadrature_points * BYTES_PER_QUADRATURE_POINT
-                + self.quadrature_entries * BYTES_PER_QUADRATURE_ENTRY
-                + self.particle_entries * BYTES_PER_PARTICLE_ENTRY)
+        let tables = self.quadrature_entries * BYTES_PER_QUADRATURE_ENTRY
+            + self.particle_entries * BYTES_PER_PARTICLE_ENTRY;
+        let model = self.particles * BYTES_PER_PARTICLE + self.quadrature_points * BYTES_PER_QUADRATURE_POINT + tables;
+        (BUILD_OVERHEAD * model).max(model + tables)
     }
 
     /// Size of a checkpoint of this model, bytes: per particle its 13
