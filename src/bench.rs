@@ -10,10 +10,12 @@
 //! the plugging case), output writing (timed in every run's summary).
 
 use crate::case::Case;
+use crate::fracture::rows::rebuild_rows_with_fallback;
 use crate::material::{Constitutive, Material, PointState, StepKinematics};
 use crate::math::{Real, Tensor3, Vec2};
+use crate::model::Gather;
 use crate::run::{build_simulation, RunError};
-use crate::shape::{build_table, AllVisible};
+use crate::shape::{build_table, AllVisible, ShapeTable};
 use crate::step::Simulation;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -140,6 +142,62 @@ pub fn force_assembly(case: &Case, threads: usize, n: usize) -> Result<Vec<Figur
                 scatter_rate,
                 "assemblies/s",
             ),
+        ])
+    })
+}
+
+/// The transpose after a crack split: patching the gather where the rows
+/// of a split's neighbourhood changed (production, [`Gather::patch_into`])
+/// against building it afresh (what every split did before). The rows
+/// within three particle supports of the plate's centre are rebuilt (with
+/// unchanged visibility: the work of a patch does not depend on what
+/// changed). Updates/s.
+pub fn gather_update(case: &Case, threads: usize, n: usize) -> Result<Vec<Figure>, RunError> {
+    with_threads(threads, || {
+        let sim = build_simulation(case)?;
+        let m = &sim.model;
+        let (np, p) = (m.particles.len(), &m.particles);
+        let (lo, hi) = p.x0.iter().fold((p.x0[0], p.x0[0]), |(lo, hi), x| (lo.inf(x), hi.sup(x)));
+        let centre = (lo + hi) * 0.5;
+        let reach = 3.0 * p.support.iter().cloned().fold(0.0, Real::max);
+        let rows: Vec<usize> = (0..m.quad.len()).filter(|&q| (m.quad.x0[q] - centre).amax() <= reach).collect();
+        let mut table = m.qp_shape.clone();
+        let mut before = ShapeTable::default();
+        rebuild_rows_with_fallback(
+            &mut table,
+            &mut before,
+            &rows,
+            &m.quad.x0,
+            &p.x0,
+            &p.support,
+            &p.volume,
+            &AllVisible,
+        )
+        .map_err(|source| crate::model::ModelError::Shape { body: "bench".into(), source })?;
+        let mut touched = vec![false; np];
+        for &q in &rows {
+            for &i in before.index[before.range(q)].iter().chain(&table.index[table.range(q)]) {
+                touched[i as usize] = true;
+            }
+        }
+        let mut out = Gather::default();
+        let t = Instant::now();
+        for _ in 0..n {
+            m.gather.patch_into(&before.offsets, &table, &rows, &touched, np, &mut out);
+        }
+        let patch_rate = n as Real / t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        for _ in 0..n {
+            std::hint::black_box(Gather::new(&table, np));
+        }
+        let fresh_rate = n as Real / t.elapsed().as_secs_f64();
+        Ok(vec![
+            fig(
+                format!("gather after a split ({} rows): patched (production), {threads} thread(s)", rows.len()),
+                patch_rate,
+                "updates/s",
+            ),
+            fig(format!("gather after a split: rebuilt (before), {threads} thread(s)"), fresh_rate, "updates/s"),
         ])
     })
 }

@@ -369,6 +369,11 @@ fn bench(name: &str, steps: usize, whole: Option<f64>, set: &[String]) -> Result
             show(&f);
         }
     }
+    for threads in [1, all] {
+        for f in bench::gather_update(&case, threads, 20)? {
+            show(&f);
+        }
+    }
     let mut rates = Vec::new();
     for threads in [1, all] {
         let f = bench::steps(&case, threads, steps)?;

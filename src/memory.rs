@@ -68,8 +68,8 @@ impl Footprint {
     /// (crack growth rewrites them into it after each split,
     /// `crate::fracture::growth`).
     pub fn bytes(&self) -> Real {
-        let tables = self.quadrature_entries * BYTES_PER_QUADRATURE_ENTRY
-            + self.particle_entries * BYTES_PER_PARTICLE_ENTRY;
+        let tables =
+            self.quadrature_entries * BYTES_PER_QUADRATURE_ENTRY + self.particle_entries * BYTES_PER_PARTICLE_ENTRY;
         let model = self.particles * BYTES_PER_PARTICLE + self.quadrature_points * BYTES_PER_QUADRATURE_POINT + tables;
         (BUILD_OVERHEAD * model).max(model + tables)
     }
