@@ -36,9 +36,10 @@ pub const BYTES_PER_PARTICLE_ENTRY: Real = 28.0;
 /// resident memory of `plugsim check` (`/usr/bin/time -f %M`): 80 MB for
 /// `borvik-1-nofracture` (estimate now 160 MiB), 281 MB for it with 48
 /// layers; a whole fine plane-strain Borvik run (cracks, output) peaked at
-/// 482 MiB (`/usr/bin/time -v`) against an estimate of 664 MiB. The
-/// estimate errs high, as a guard should (it was 467 MiB, below the run's
-/// peak, while the gather's copies of `N` and `∇N` were left out).
+/// 607 MiB (`/usr/bin/time -v`) against an estimate of 799 MiB (472 MiB
+/// before crack growth kept spare tables). The estimate errs high, as a
+/// guard should (it was once below the run's peak, while the gather's
+/// copies of `N` and `∇N` were left out).
 pub const BUILD_OVERHEAD: Real = 1.5;
 /// Memory assumed available where `/proc/meminfo` cannot be read (other
 /// operating systems, restricted containers): 16 GiB, a typical workstation.
