@@ -203,16 +203,7 @@ pub fn gather_update(case: &Case, threads: usize, n: usize) -> Result<Vec<Figure
 }
 
 fn gather(sim: &Simulation, f: &mut [Vec2]) {
-    let m = &sim.model;
-    let (g, pw, xq, mode) = (&m.gather, &m.quad.pw, &m.quad.x0, m.mode);
-    f.par_iter_mut().enumerate().for_each(|(i, fi)| {
-        let mut acc = Vec2::zeros();
-        for j in g.range(i) {
-            let q = g.point[j] as usize;
-            acc += mode.internal_force(&pw[q], g.value[j], &g.grad[j], &xq[q]);
-        }
-        *fi = acc;
-    });
+    crate::step::gather_internal_force(&sim.model, f);
 }
 
 fn scatter(sim: &Simulation) -> Vec<Vec2> {

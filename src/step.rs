@@ -518,15 +518,9 @@ impl Simulation {
     /// `f_int,I = Σ_q (P w)_q ∇N_I(X_q)` (+ hoop term), gathered per particle.
     fn internal_force(&mut self) {
         let m = &mut self.model;
-        let (gather, pw, xq, mode) = (&m.gather, &m.quad.pw, &m.quad.x0, m.mode);
-        m.particles.f_int.par_iter_mut().enumerate().for_each(|(i, f)| {
-            let mut acc = Vec2::zeros();
-            for j in gather.range(i) {
-                let q = gather.point[j] as usize;
-                acc += mode.internal_force(&pw[q], gather.value[j], &gather.grad[j], &xq[q]);
-            }
-            *f = acc;
-        });
+        let mut f_int = std::mem::take(&mut m.particles.f_int);
+        gather_internal_force(m, &mut f_int);
+        m.particles.f_int = f_int;
     }
 
     /// Catch NaN/Inf and runaway speeds right after the stages that make them.
@@ -574,6 +568,22 @@ impl Simulation {
         }
         Ok(())
     }
+}
+
+/// `f_int,I = Σ_q (P w)_q ∇N_I(X_q)` (+ the hoop term in axisymmetry; SPEC
+/// §4) into `f` (one entry per particle): each particle sums its own
+/// entries of the gather in their fixed order, so the result is the same
+/// for any number of threads.
+pub fn gather_internal_force(m: &Model, f: &mut [Vec2]) {
+    let (gather, pw, xq, mode) = (&m.gather, &m.quad.pw, &m.quad.x0, m.mode);
+    f.par_iter_mut().enumerate().for_each(|(i, f)| {
+        let mut acc = Vec2::zeros();
+        for j in gather.range(i) {
+            let q = gather.point[j] as usize;
+            acc += mode.internal_force(&pw[q], gather.value[j], &gather.grad[j], &xq[q]);
+        }
+        *f = acc;
+    });
 }
 
 /// The kinematics of one quadrature point over a step: `d` and `w` of the
