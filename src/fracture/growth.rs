@@ -197,11 +197,22 @@ pub struct CrackGrowth {
 }
 
 /// See [`CrackGrowth::spare`].
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Default)]
 struct Spare {
     gather: Gather,
     qp_shape: ShapeTable,
     particle_shape: ShapeTable,
+}
+
+impl std::fmt::Debug for Spare {
+    /// Sizes only: the contents are scratch.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Spare")
+            .field("gather_entries", &self.gather.entry.len())
+            .field("qp_entries", &self.qp_shape.nnz())
+            .field("particle_entries", &self.particle_shape.nnz())
+            .finish()
+    }
 }
 
 /// Scratch of the failed-zone search of one nucleation stage.
