@@ -524,19 +524,25 @@ fn concat_tables(parts: Vec<ShapeTable>) -> ShapeTable {
 mod tests {
     use super::*;
 
-    /// Patching the transpose after some rows changed length and content,
-    /// and new particles appeared in them, gives exactly the transpose built
-    /// afresh, for 1, 2 and 3 worker threads, including the entry indices
-    /// of the unchanged rows, which shift with the rows before them.
-    #[test]
-    fn patched_gather_equals_a_fresh_one() {
+    /// The shape table of a 9 × 9 particle lattice at 64 points off the
+    /// lattice; `(9, table)`.
+    fn lattice_table() -> (usize, ShapeTable) {
         let h = 1e-3;
         let n = 9;
         let x0: Vec<Vec2> = (0..n * n).map(|k| Vec2::new((k % n) as Real * h, (k / n) as Real * h)).collect();
         let points: Vec<Vec2> = (0..(n - 1) * (n - 1))
             .map(|k| Vec2::new(((k % (n - 1)) as Real + 0.4) * h, ((k / (n - 1)) as Real + 0.7) * h))
             .collect();
-        let old = build_table(&points, &x0, &vec![2.2 * h; n * n], &vec![h * h; n * n], &AllVisible).unwrap();
+        (n, build_table(&points, &x0, &vec![2.2 * h; n * n], &vec![h * h; n * n], &AllVisible).unwrap())
+    }
+
+    /// Patching the transpose after some rows changed length and content,
+    /// and new particles appeared in them, gives exactly the transpose built
+    /// afresh, for 1, 2 and 3 worker threads, including the entry indices
+    /// of the unchanged rows, which shift with the rows before them.
+    #[test]
+    fn patched_gather_equals_a_fresh_one() {
+        let (n, old) = lattice_table();
         // Rebuilt rows: every third entry dropped, one or two new particles
         // (indices n², n² + 1) added; the first and the last row among them.
         let changed: Vec<usize> = vec![0, 5, 6, 20, 33, old.rows() - 1];
@@ -587,13 +593,7 @@ mod tests {
     /// worker threads.
     #[test]
     fn gather_is_the_same_for_any_number_of_threads() {
-        let h = 1e-3;
-        let n = 9;
-        let x0: Vec<Vec2> = (0..n * n).map(|k| Vec2::new((k % n) as Real * h, (k / n) as Real * h)).collect();
-        let points: Vec<Vec2> = (0..(n - 1) * (n - 1))
-            .map(|k| Vec2::new(((k % (n - 1)) as Real + 0.4) * h, ((k / (n - 1)) as Real + 0.7) * h))
-            .collect();
-        let table = build_table(&points, &x0, &vec![2.2 * h; n * n], &vec![h * h; n * n], &AllVisible).unwrap();
+        let (n, table) = lattice_table();
         let mut serial: Vec<Vec<u32>> = vec![Vec::new(); n * n];
         for q in 0..table.rows() {
             for k in table.range(q) {
