@@ -14,7 +14,7 @@ use plugsim::fracture::{CrackGrowth, Criterion, EventKind, FractureParameters};
 use plugsim::geometry::GeometryMode;
 use plugsim::material::{Elastic, Material};
 use plugsim::math::{Block2, Real, Vec2};
-use plugsim::model::{BodySetup, Model};
+use plugsim::model::{BodySetup, Gather, Model};
 use plugsim::particles::ParticleFlags;
 use plugsim::shape::ShapeTable;
 use plugsim::step::{Simulation, TimeStepRule};
@@ -85,7 +85,8 @@ fn snapshot(m: &Model) -> Invariants {
 }
 
 /// Mass and momentum unchanged, reproduction at every quadrature point,
-/// and no (evaluation point, particle) pair of either table across a crack.
+/// no (evaluation point, particle) pair of either table across a crack, and
+/// the force gather equal to the transpose of the table.
 fn check_invariants(m: &Model, growth: &CrackGrowth, before: &Invariants, what: &str) {
     let p = &m.particles;
     let mass = p.total_mass();
@@ -138,7 +139,8 @@ fn check_invariants(m: &Model, growth: &CrackGrowth, before: &Invariants, what: 
     crossing(&m.qp_shape, &m.quad.x0, "quadrature");
     crossing(&m.particle_shape, &p.x0, "particle");
     assert_eq!(m.particle_shape.rows(), p.len());
-    assert_eq!(m.gather.offsets.len(), p.len() + 1);
+    // The gather patched after each split is the transpose of the table.
+    assert!(m.gather == Gather::new(&m.qp_shape, p.len()), "{what}: patched gather differs from a fresh one");
 }
 
 /// Drive growth with a prescribed criterion field; check the invariants
