@@ -790,9 +790,11 @@ impl CrackGrowth {
     }
 
     /// Recompute the quadrature and particle rows with evaluation points in
-    /// the box `[lo, hi]` grown by the largest support, the gather, the
-    /// lumped masses of the particles in the old or new rows, and restore
-    /// the linear momentum `momentum` (module doc).
+    /// the box `[lo, hi]` grown by the largest support, patch the gather
+    /// where those rows changed ([`Gather::patch_into`]), re-lump the masses
+    /// of the particles in the old or new rows, and restore the linear
+    /// momentum `momentum` (module doc). The tables and the gather are
+    /// rewritten into [`CrackGrowth::spare`] and swapped in.
     fn rebuild_local(
         &mut self,
         model: &mut Model,
