@@ -107,7 +107,7 @@ pub struct Gather {
 impl Gather {
     /// Build from a table whose column indices are particles `0..n`.
     ///
-    /// In parallel over blocks of particles ([`Gather::fill`]): each block
+    /// In parallel over blocks of particles (`Gather::fill`): each block
     /// scans the table's indices and fills only its own particles' entries.
     /// Every particle's entries are still written in ascending entry order,
     /// so the result does not depend on the number of blocks (test

@@ -80,7 +80,7 @@ pub trait Constitutive {
 /// Kirchhoff stress is reduced to its compressive mean part,
 /// `τ → min(τ_m, 0) I`. Only pressure from closing material remains.
 ///
-/// Deviation from SPEC §6 (which carries no such rule; [RL10] uses `D`
+/// Deviation from SPEC §6 (which carries no such rule; \[RL10\] uses `D`
 /// only as a crack criterion): cracks advance by one particle per step at
 /// most and wait for the material ahead of the tip to meet the crack
 /// criterion; meanwhile the opening crack stretches the points just ahead
