@@ -125,7 +125,7 @@ pub fn force_assembly(case: &Case, threads: usize, n: usize) -> Result<Vec<Figur
         let t = Instant::now();
         let mut f = vec![Vec2::zeros(); np];
         for _ in 0..n {
-            gather(&sim, &mut f);
+            crate::step::gather_internal_force(&sim.model, &mut f);
         }
         let gather_rate = n as Real / t.elapsed().as_secs_f64();
         std::hint::black_box(&f);
@@ -174,12 +174,7 @@ pub fn gather_update(case: &Case, threads: usize, n: usize) -> Result<Vec<Figure
             &AllVisible,
         )
         .map_err(|source| crate::model::ModelError::Shape { body: "bench".into(), source })?;
-        let mut touched = vec![false; np];
-        for &q in &rows {
-            for &i in before.index[before.range(q)].iter().chain(&table.index[table.range(q)]) {
-                touched[i as usize] = true;
-            }
-        }
+        let touched = Gather::touched(&before, &table, &rows, np);
         let mut out = Gather::default();
         let t = Instant::now();
         for _ in 0..n {
@@ -200,10 +195,6 @@ pub fn gather_update(case: &Case, threads: usize, n: usize) -> Result<Vec<Figure
             fig(format!("gather after a split: rebuilt (before), {threads} thread(s)"), fresh_rate, "updates/s"),
         ])
     })
-}
-
-fn gather(sim: &Simulation, f: &mut [Vec2]) {
-    crate::step::gather_internal_force(&sim.model, f);
 }
 
 fn scatter(sim: &Simulation) -> Vec<Vec2> {

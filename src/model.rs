@@ -139,6 +139,19 @@ impl Gather {
         gather
     }
 
+    /// The particles (of `n`) in rows `changed` of the table `before` or
+    /// `after` a rebuild: those whose entries [`Gather::patch_into`] must
+    /// merge, and whose lumped masses change.
+    pub fn touched(before: &ShapeTable, after: &ShapeTable, changed: &[usize], n: usize) -> Vec<bool> {
+        let mut touched = vec![false; n];
+        for &q in changed {
+            for &i in before.index[before.range(q)].iter().chain(&after.index[after.range(q)]) {
+                touched[i as usize] = true;
+            }
+        }
+        touched
+    }
+
     /// The transpose of `table` after its rows `changed` (ascending, no
     /// repeats) were rebuilt, written into `out` (its allocations reused),
     /// from `self`, the transpose of the table before, whose row starts were
@@ -566,12 +579,7 @@ mod tests {
             }
             new.offsets.push(new.index.len());
         }
-        let mut touched = vec![false; n * n + 2];
-        for &q in &changed {
-            for &i in old.index[old.range(q)].iter().chain(&new.index[new.range(q)]) {
-                touched[i as usize] = true;
-            }
-        }
+        let touched = Gather::touched(&old, &new, &changed, n * n + 2);
         for threads in [1, 2, 3] {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             let (fresh, patched) = pool.install(|| {

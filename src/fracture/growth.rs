@@ -813,12 +813,6 @@ impl CrackGrowth {
             ps.offsets.push(end);
         }
         let rows_p: Vec<usize> = (0..n).filter(|&i| inside(&model.particles.x0[i])).collect();
-        let mut touched = vec![false; n];
-        for &q in &rows_q {
-            for k in model.qp_shape.range(q) {
-                touched[model.qp_shape.index[k] as usize] = true;
-            }
-        }
         // The RK deformation gradients before the change (module doc:
         // "deformation gradient across a crack change").
         let f_before: Vec<Tensor3> = rows_q.iter().map(|&q| model.shape_deformation_gradient(q)).collect();
@@ -858,11 +852,6 @@ impl CrackGrowth {
             }
             map.extend(reduced);
         }
-        for &q in &rows_q {
-            for k in model.qp_shape.range(q) {
-                touched[model.qp_shape.index[k] as usize] = true;
-            }
-        }
         for (&q, before) in rows_q.iter().zip(&f_before) {
             let after = model.shape_deformation_gradient(q);
             if after != *before {
@@ -872,6 +861,7 @@ impl CrackGrowth {
         // The table before the rebuild is now the spare one (its row starts
         // place the old gather's entries).
         let spare = &mut self.spare;
+        let touched = Gather::touched(&spare.qp_shape, &model.qp_shape, &rows_q, n);
         model.gather.patch_into(&spare.qp_shape.offsets, &model.qp_shape, &rows_q, &touched, n, &mut spare.gather);
         std::mem::swap(&mut model.gather, &mut spare.gather);
         let touched: Vec<usize> = (0..n).filter(|&i| touched[i]).collect();

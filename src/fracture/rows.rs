@@ -159,18 +159,12 @@ pub fn rebuild_rows_with_fallback(
         .par_iter()
         .map_init(Vec::new, |cand, &r| row_with_fallback(r, &points[r], &search, x0, support, volume, vis, cand))
         .collect::<Result<_, _>>()?;
-    let mut fresh = Vec::with_capacity(which.len());
-    let mut reduced = Vec::new();
-    for (&r, (row, basis)) in which.iter().zip(built) {
-        if basis != Basis::Bilinear {
-            reduced.push((r, basis));
-        }
-        fresh.push(row);
-    }
+    let reduced: Vec<(usize, Basis)> =
+        which.iter().zip(&built).filter(|(_, (_, b))| *b != Basis::Bilinear).map(|(&r, &(_, b))| (r, b)).collect();
     // Sized up front: growing the columns entry by entry reallocated and
     // copied the whole table a few times per split.
     let nnz = table.nnz() - which.iter().map(|&r| table.range(r).len()).sum::<usize>()
-        + fresh.iter().map(|row| row.len()).sum::<usize>();
+        + built.iter().map(|(row, _)| row.len()).sum::<usize>();
     let out = spare;
     out.offsets.clear();
     out.index.clear();
@@ -181,7 +175,7 @@ pub fn rebuild_rows_with_fallback(
     out.value.reserve(nnz);
     out.grad.reserve(nnz);
     out.offsets.push(0);
-    let mut next = which.iter().zip(fresh).peekable();
+    let mut next = which.iter().zip(built.into_iter().map(|(row, _)| row)).peekable();
     for r in 0..table.rows() {
         match next.peek() {
             Some((&w, _)) if w == r => {
