@@ -152,13 +152,18 @@ fn load(case_file: &Option<PathBuf>, builtin: &Option<String>, set: &[String]) -
 
 fn main() {
     let cli = Cli::parse();
-    if let Some(n) = cli.threads {
-        if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n).build_global() {
-            eprintln!("error: cannot set up {n} threads: {e}");
+    // The command runs on a worker of the pool, not on the main thread: a
+    // parallel loop started from a worker runs there at once, while one
+    // started from outside the pool is queued, wakes a worker and puts the
+    // caller to sleep until it is done (tens of such round trips a step).
+    let pool = match rayon::ThreadPoolBuilder::new().num_threads(cli.threads.unwrap_or(0)).build() {
+        Ok(pool) => pool,
+        Err(e) => {
+            eprintln!("error: cannot set up {} threads: {e}", cli.threads.unwrap_or(0));
             std::process::exit(2);
         }
-    }
-    let code = match dispatch(cli.command) {
+    };
+    let code = match pool.install(|| dispatch(cli.command)) {
         Ok(()) => 0,
         Err(e) => {
             eprintln!("error: {e:#}");

@@ -182,6 +182,8 @@ pub struct Simulation {
     pub cracks: Option<CrackGrowth>,
     /// Per-point internal-energy increments of the last step (scratch).
     work_scratch: Vec<Real>,
+    /// Per-particle full-step kinetic energies of the last step (scratch).
+    kinetic_scratch: Vec<Real>,
 }
 
 impl Simulation {
@@ -228,6 +230,7 @@ impl Simulation {
             f_contact: vec![Vec2::zeros(); np],
             cracks: None,
             work_scratch: vec![0.0; nq],
+            kinetic_scratch: vec![0.0; np],
         }
     }
 
@@ -378,18 +381,21 @@ impl Simulation {
     /// Kinetic energy at the full step `t_{n+1}`, from the full-step velocity
     /// `V^{n+1} = V^{n+½} + ½ Δt a^{n+1}` (velocity-Verlet form of the central
     /// difference), so that it is reported at the same instant as the
-    /// internal energy, whose state is `τ^{n+1}`. Summed in index order.
-    fn full_step_kinetic_energy(&self) -> Real {
+    /// internal energy, whose state is `τ^{n+1}`. The particles' terms are
+    /// formed in parallel and summed in index order (the same bits for any
+    /// number of threads).
+    fn full_step_kinetic_energy(&mut self) -> Real {
         let p = &self.model.particles;
         let half = 0.5 * self.dt;
-        (0..p.len())
-            .map(|i| {
-                let fc = self.f_contact.get(i).copied().unwrap_or_else(Vec2::zeros);
-                let mut acc = (p.f_ext[i] + fc - p.f_int[i]) / p.mass[i];
-                constrain(p.flags[i], &mut acc);
-                0.5 * p.mass[i] * (p.v[i] + acc * half).norm_squared()
-            })
-            .sum()
+        let fc = &self.f_contact;
+        self.kinetic_scratch.resize(p.len(), 0.0);
+        self.kinetic_scratch.par_iter_mut().enumerate().for_each(|(i, e)| {
+            let fc = fc.get(i).copied().unwrap_or_else(Vec2::zeros);
+            let mut acc = (p.f_ext[i] + fc - p.f_int[i]) / p.mass[i];
+            constrain(p.flags[i], &mut acc);
+            *e = 0.5 * p.mass[i] * (p.v[i] + acc * half).norm_squared();
+        });
+        self.kinetic_scratch.iter().sum()
     }
 
     /// Deformation and velocity gradients, material update, `P w`.

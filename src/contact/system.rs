@@ -12,6 +12,7 @@
 //! 3. [`ContactSystem::advance`] takes the new `V^{n+½}`, moves the rigid
 //!    bodies under the reactions, and accumulates the contact work.
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::force::{coulomb_cap, inverse_distance_weights, one_step_normal_force, stick_force, Spreading};
@@ -286,6 +287,19 @@ pub struct ContactSystem {
     gap_w: Vec<(u32, Real)>,
     force_w: Vec<(u32, Real)>,
     candidates: Vec<Candidate>,
+    /// Scratch: each slave's contact-free gap point of the current step.
+    gap_points: Vec<GapPoint>,
+}
+
+/// A slave's gap point over the step: the shape-weighted sums of its row.
+#[derive(Clone, Copy, Debug)]
+struct GapPoint {
+    /// Contact-free predicted position `X + Ũ^{n+1}`, m.
+    predicted: Vec2,
+    /// Position at the start of the step `X + U^n`, m.
+    now: Vec2,
+    /// Contact-free predicted velocity `Ṽ`, m/s.
+    velocity: Vec2,
 }
 
 impl ContactSystem {
@@ -308,6 +322,7 @@ impl ContactSystem {
             gap_w: Vec::new(),
             force_w: Vec::new(),
             candidates: Vec::new(),
+            gap_points: Vec::new(),
         })
     }
 
@@ -452,29 +467,29 @@ impl ContactSystem {
             self.predicted_position[b] = body.position + body.predicted_velocity() * dt;
         }
 
-        // 1. Prediction and search.
+        // 1. Prediction (in parallel: every slave's gap point) and search.
+        let slaves = self.slaves.particles();
+        self.gap_points
+            .resize(slaves.len(), GapPoint { predicted: Vec2::zeros(), now: Vec2::zeros(), velocity: Vec2::zeros() });
+        let predicted = self.gap_points.par_iter_mut().zip(slaves.par_iter()).try_for_each(|(g, &s)| {
+            *g = predict_gap_point(input, s as usize, spreading)?;
+            Ok(())
+        });
+        if let Err(e) = predicted {
+            // Name the first slave in order that fails, as a serial loop would.
+            return Err(slaves
+                .iter()
+                .find_map(|&s| predict_gap_point(input, s as usize, spreading).err())
+                .unwrap_or(e));
+        }
         for k in 0..self.slaves.len() {
             let s = self.slaves.particles()[k] as usize;
-            let gap_start = self.gap_w.len();
-            match spreading {
-                Spreading::None | Spreading::InverseDistance => self.gap_w.push((s as u32, 1.0)),
-                Spreading::ShapeFunction => shape_row(input, s, &mut self.gap_w)?,
-            }
-            let gap_rows = (gap_start as u32, self.gap_w.len() as u32);
-            let (mut x, mut x_now) = (input.x0[s], input.x0[s]);
-            let mut vel = Vec2::zeros();
-            for &(j, w) in &self.gap_w[gap_start..] {
-                let (u_pred, v_pred) = input.predicted(j as usize)?;
-                x += u_pred * w;
-                x_now += input.u[j as usize] * w;
-                vel += v_pred * w;
-            }
-            if !x.iter().chain(vel.iter()).all(|c| c.is_finite()) {
-                return Err(ContactError::NonFinite { particle: s, quantity: "predicted position or velocity" });
-            }
+            let GapPoint { predicted: x, now: x_now, velocity: vel } = self.gap_points[k];
+            // The gap point's row, written into `gap_w` once the slave
+            // penetrates a body.
+            let mut gap_rows: Option<(u32, u32)> = None;
             let last = self.slaves.pairing(k);
             let mut found: Option<Pairing> = None;
-            let mut used = false;
             for (b, body) in self.bodies.iter().enumerate() {
                 let at = self.predicted_position[b];
                 if !body.bounding_box_contains(&(x - at)) {
@@ -494,6 +509,17 @@ impl ContactSystem {
                 if gap >= 0.0 {
                     continue;
                 }
+                let gap_rows = match gap_rows {
+                    Some(rows) => rows,
+                    None => {
+                        let start = self.gap_w.len();
+                        match spreading {
+                            Spreading::None | Spreading::InverseDistance => self.gap_w.push((s as u32, 1.0)),
+                            Spreading::ShapeFunction => shape_row(input, s, &mut self.gap_w)?,
+                        }
+                        *gap_rows.insert((start as u32, self.gap_w.len() as u32))
+                    }
+                };
                 let force_rows = match spreading {
                     Spreading::None | Spreading::ShapeFunction => gap_rows,
                     Spreading::InverseDistance => {
@@ -520,7 +546,6 @@ impl ContactSystem {
                         }
                     }
                 }
-                used = true;
                 self.candidates.push(Candidate {
                     particle: s as u32,
                     pairing,
@@ -536,9 +561,6 @@ impl ContactSystem {
                     f_t: 0.0,
                     slipping: false,
                 });
-            }
-            if !used {
-                self.gap_w.truncate(gap_start);
             }
             self.slaves.set_pairing(k, found);
         }
@@ -702,6 +724,14 @@ fn effective_mass(compliance: Real) -> Real {
 /// Row `s` of the particle shape table as (particle, N) pairs, with its
 /// partition of unity checked.
 fn shape_row(input: &StepInput, s: usize, out: &mut Vec<(u32, Real)>) -> Result<(), ContactError> {
+    let table = checked_shape_row(input, s)?;
+    out.extend(table.range(s).map(|e| (table.index[e], table.value[e])));
+    Ok(())
+}
+
+/// The particle shape table, once row `s` is checked: indices in range and
+/// the partition of unity.
+fn checked_shape_row<'a>(input: &StepInput<'a>, s: usize) -> Result<&'a ShapeTable, ContactError> {
     // `validate` guarantees the table exists with one row per particle.
     let Some(table) = input.shape else {
         return Err(ContactError::MissingShapeTable { spreading: Spreading::ShapeFunction });
@@ -714,12 +744,39 @@ fn shape_row(input: &StepInput, s: usize, out: &mut Vec<(u32, Real)>) -> Result<
             return Err(ContactError::ShapeIndexOutOfRange { row: s, particle: j as usize, particles: n });
         }
         sum += table.value[e];
-        out.push((j, table.value[e]));
     }
     if sum.is_nan() || (sum - 1.0).abs() > PARTITION_TOLERANCE {
         return Err(ContactError::PartitionOfUnity { particle: s, sum });
     }
-    Ok(())
+    Ok(table)
+}
+
+/// The contact-free gap point of slave `s` over the step (SPEC §8): the
+/// predicted position and velocity and the current position, weighted by
+/// its shape-function row in row order (by the particle alone without
+/// shape-function spreading).
+fn predict_gap_point(input: &StepInput, s: usize, spreading: Spreading) -> Result<GapPoint, ContactError> {
+    let mut g = GapPoint { predicted: input.x0[s], now: input.x0[s], velocity: Vec2::zeros() };
+    let mut add = |j: usize, w: Real| -> Result<(), ContactError> {
+        let (u_pred, v_pred) = input.predicted(j)?;
+        g.predicted += u_pred * w;
+        g.now += input.u[j] * w;
+        g.velocity += v_pred * w;
+        Ok(())
+    };
+    match spreading {
+        Spreading::None | Spreading::InverseDistance => add(s, 1.0)?,
+        Spreading::ShapeFunction => {
+            let table = checked_shape_row(input, s)?;
+            for e in table.range(s) {
+                add(table.index[e] as usize, table.value[e])?;
+            }
+        }
+    }
+    if !g.predicted.iter().chain(g.velocity.iter()).all(|c| c.is_finite()) {
+        return Err(ContactError::NonFinite { particle: s, quantity: "predicted position or velocity" });
+    }
+    Ok(g)
 }
 
 /// Inverse-distance spreading weights of slave `s` over the particles of its
