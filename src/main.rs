@@ -156,10 +156,12 @@ fn main() {
     // parallel loop started from a worker runs there at once, while one
     // started from outside the pool is queued, wakes a worker and puts the
     // caller to sleep until it is done (tens of such round trips a step).
-    let pool = match rayon::ThreadPoolBuilder::new().num_threads(cli.threads.unwrap_or(0)).build() {
+    // `0`: rayon's default (RAYON_NUM_THREADS, else one per core).
+    let threads = cli.threads.unwrap_or(0);
+    let pool = match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
         Ok(pool) => pool,
         Err(e) => {
-            eprintln!("error: cannot set up {} threads: {e}", cli.threads.unwrap_or(0));
+            eprintln!("error: cannot set up {threads} threads: {e}");
             std::process::exit(2);
         }
     };
