@@ -595,6 +595,20 @@ fn drive(
             s.eroded_points
         );
     }
+    match s.exposed.contacts {
+        Some((first, last, most)) => println!(
+            "  contact: {} interior particles joined the slaves when the projectile reached them; they carried contact force from {:.3} to {:.3} us (at most {} at once; history.csv: exposed_contacts)",
+            s.exposed.admitted,
+            first * 1e6,
+            last * 1e6,
+            most
+        ),
+        None if s.exposed.admitted > 0 => println!(
+            "  contact: {} interior particles joined the slaves when the projectile came within a spacing; none was pushed",
+            s.exposed.admitted
+        ),
+        None => {}
+    }
     match &s.plug {
         Some(p) => {
             let v = p.velocity();

@@ -20,7 +20,10 @@ use std::path::{Path, PathBuf};
 /// [`crate::plug`]) with `perforation_time`, the time of the step after
 /// which it was first found (s; 0 before), and `eroded_points`, the number
 /// of quadrature points eroded so far (inverted after failing, see
-/// [`crate::fracture`]). Each rigid body `NAME` adds `NAME_x, NAME_y` (m), `NAME_vx, NAME_vy` (m/s),
+/// [`crate::fracture`]), `exposed_slaves`, the particles that joined the
+/// contact slaves by exposure so far, and `exposed_contacts`, how many of
+/// them touched a rigid body in the last step (see
+/// [`crate::contact::ContactSystem::admit_exposed`]). Each rigid body `NAME` adds `NAME_x, NAME_y` (m), `NAME_vx, NAME_vy` (m/s),
 /// `NAME_fx, NAME_fy` (contact force on the body, N) and `NAME_contacts`.
 pub const HISTORY_COLUMNS: &[&str] = &[
     "time",
@@ -38,6 +41,8 @@ pub const HISTORY_COLUMNS: &[&str] = &[
     "plug_vy",
     "perforation_time",
     "eroded_points",
+    "exposed_slaves",
+    "exposed_contacts",
 ];
 
 /// Columns of `cracks.csv`: one row per crack event; `particles` lists the
@@ -235,6 +240,9 @@ impl OutputWriter {
         }
         row.push(self.plug.first_cut.unwrap_or(0.0));
         row.push(sim.model.quad.eroded.iter().filter(|&&e| e).count() as Real);
+        let (admitted, touching) =
+            sim.contact.as_ref().map_or((0, 0), |c| c.exposed_counts(&sim.model.particles.flags));
+        row.extend([admitted as Real, touching as Real]);
         if let Some(c) = &sim.contact {
             for b in 0..c.bodies.len() {
                 let s = c.sample(b).expect("body exists");
@@ -580,6 +588,37 @@ pub fn last_contact_times(dir: &Path, rigid_names: &[String]) -> Result<Vec<(Str
             (n.clone(), last)
         })
         .collect())
+}
+
+/// Slaves by exposure, from the run's `history.csv`: the particles admitted
+/// by the end (`exposed_slaves` of the last row) and, if any of them
+/// touched a rigid body in a history row, the first and last such row's
+/// time, s, and the most in one row (`exposed_contacts`).
+pub fn exposed_contact_summary(dir: &Path) -> Result<ExposedSummary, IoError> {
+    let table = crate::io::HistoryTable::read(&dir.join("history.csv"))?;
+    let time = table.column("time").unwrap_or_default();
+    let admitted = table.column("exposed_slaves").and_then(|c| c.last().copied()).unwrap_or(0.0) as usize;
+    let touching: Vec<(Real, Real)> = table
+        .column("exposed_contacts")
+        .map(|c| c.iter().zip(time).filter(|(n, _)| **n > 0.0).map(|(n, t)| (*t, *n)).collect())
+        .unwrap_or_default();
+    let contacts = match (touching.first(), touching.last()) {
+        (Some(first), Some(last)) => {
+            Some((first.0, last.0, touching.iter().map(|(_, n)| *n as usize).max().unwrap_or(0)))
+        }
+        _ => None,
+    };
+    Ok(ExposedSummary { admitted, contacts })
+}
+
+/// What [`exposed_contact_summary`] reads off the history.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ExposedSummary {
+    /// Particles admitted to the contact slaves by exposure by the end.
+    pub admitted: usize,
+    /// First and last history row with admitted particles in contact (s),
+    /// and the most in contact in one row.
+    pub contacts: Option<(Real, Real, usize)>,
 }
 
 #[cfg(test)]

@@ -101,6 +101,9 @@ pub struct RunSummary {
     /// Quadrature points eroded by the end (inverted after failing,
     /// [`crate::fracture`]).
     pub eroded_points: usize,
+    /// Particles that joined the contact slaves by exposure, and when they
+    /// touched a rigid body ([`crate::contact::ContactSystem::admit_exposed`]).
+    pub exposed: crate::output::ExposedSummary,
     /// Velocity of each rigid body at the end, (name, (vx, vy)) m/s.
     pub rigid_velocities: Vec<(String, [Real; 2])>,
     /// Time of each rigid body's last contact (history rows), s.
@@ -481,6 +484,7 @@ fn time_loop(
         perforation,
         plug,
         eroded_points: sim.model.quad.eroded.iter().filter(|&&e| e).count(),
+        exposed: crate::output::exposed_contact_summary(&cfg.out_dir)?,
         cracks,
         separation,
         rigid_velocities,

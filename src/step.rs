@@ -235,8 +235,9 @@ impl Simulation {
     }
 
     /// Advance one step `t → t + Δt`. Stages, in order:
-    /// 0. contact (SPEC §8): search and one-step forces from the contact-free
-    ///    predictor, which needs this step's `f_int(U^n)` — so contact runs
+    /// 0. contact (SPEC §8): particles the projectile reaches join the slaves
+    ///    ([`ContactSystem::admit_exposed`]), then search and one-step forces
+    ///    from the contact-free predictor, which needs this step's `f_int(U^n)` — so contact runs
     ///    after the previous step's internal force and before integration;
     /// 1. time integration: `a = (f_ext + f_contact − f_int)/m`, `V ← V + Δt a`,
     ///    `U ← U + Δt V`, constraints (SPEC §5); rigid bodies advance under
@@ -320,6 +321,7 @@ impl Simulation {
             return Ok(());
         };
         let p = &self.model.particles;
+        contact.admit_exposed(&p.x0, &p.u, &p.spacing);
         self.f_contact.resize(p.len(), Vec2::zeros());
         let input = StepInput::from_particles(p, Some(&self.model.particle_shape), dt);
         contact.compute_forces(&input, &mut self.f_contact).map_err(|source| SolverError::Contact {

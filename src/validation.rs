@@ -172,6 +172,13 @@ impl Outcome {
         Some(if self.row.case.geometry == "axisymmetric" { plug.mass * 1e3 } else { plug.mass })
     }
 
+    /// First and last time (s) that particles admitted to the contact slaves
+    /// by exposure touched the projectile (history rows), if they did
+    /// ([`crate::contact::ContactSystem::admit_exposed`]).
+    pub fn exposed_contacts(&self) -> Option<(Real, Real)> {
+        self.result.as_ref().ok()?.exposed.contacts.map(|(a, b, _)| (a, b))
+    }
+
     /// Plug speed along the impact direction (−y) at the end, m/s.
     pub fn plug_speed(&self) -> Option<Real> {
         Some(-self.result.as_ref().ok()?.plug.as_ref()?.velocity().y)
@@ -229,10 +236,10 @@ fn material_label(case: &BorvikCase) -> &'static str {
 /// The table as Markdown and CSV.
 pub fn table(outcomes: &[Outcome]) -> (String, String) {
     let mut md = String::from(
-        "| case | geometry | discretization | criterion | material | particles | steps | wall (s) | residual (m/s) | experiment (m/s) | error % | [RL10] (m/s) | perforation (µs) | [RL10] perforation (µs) | plug mass (g; g/mm in plane strain) | plug velocity (m/s) | last contact (µs) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| case | geometry | discretization | criterion | material | particles | steps | wall (s) | residual (m/s) | experiment (m/s) | error % | [RL10] (m/s) | perforation (µs) | [RL10] perforation (µs) | plug mass (g; g/mm in plane strain) | plug velocity (m/s) | last contact (µs) | exposed contacts (µs) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let mut csv = String::from(
-        "row,case,geometry,discretization,criterion,material,particles,steps,wall_s,residual_m_s,experiment_m_s,error_percent,paper_m_s,perforation_us,paper_perforation_us,plug_mass,plug_velocity_m_s,last_contact_us,status\n",
+        "row,case,geometry,discretization,criterion,material,particles,steps,wall_s,residual_m_s,experiment_m_s,error_percent,paper_m_s,perforation_us,paper_perforation_us,plug_mass,plug_velocity_m_s,last_contact_us,exposed_first_us,exposed_last_us,status\n",
     );
     for o in outcomes {
         let (r, c) = (&o.row, &o.row.case);
@@ -250,8 +257,9 @@ pub fn table(outcomes: &[Outcome]) -> (String, String) {
         let paper_perforation = r.experiment.perforation_time * 1e6;
         let perforation = o.perforation().map(|t| t * 1e6);
         let last_contact = o.last_contact.map(|t| t * 1e6);
+        let exposed = o.exposed_contacts();
         md.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {} | {:.1} | {} | {} | {} | {:.0} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {} | {:.1} | {} | {} | {} | {:.0} | {} | {} | {} | {} |\n",
             r.experiment.name,
             c.geometry,
             c.discretization,
@@ -269,9 +277,10 @@ pub fn table(outcomes: &[Outcome]) -> (String, String) {
             fmt_opt(o.plug_mass(), 2),
             fmt_opt(o.plug_speed(), 1),
             fmt_opt(last_contact, 1),
+            exposed.map_or_else(|| "—".to_string(), |(a, b)| format!("{:.1}–{:.1}", a * 1e6, b * 1e6)),
         ));
         csv.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{:.3},{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{:.3},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             r.id,
             r.experiment.name,
             c.geometry,
@@ -290,6 +299,8 @@ pub fn table(outcomes: &[Outcome]) -> (String, String) {
             fmt_csv(o.plug_mass(), 4),
             fmt_csv(o.plug_speed(), 3),
             fmt_csv(last_contact, 3),
+            fmt_csv(exposed.map(|e| e.0 * 1e6), 3),
+            fmt_csv(exposed.map(|e| e.1 * 1e6), 3),
             status.replace(',', ";"),
         ));
     }
@@ -373,7 +384,9 @@ has flown free of contact (no slave particle pushing on it in `history.csv`) for
 plate. Each run stops 20 µs after the projectile's last contact once the plug is cut out \
 (`--full-time`: at the paper's simulated time). Plug: the particles the through-cracks separate from the clamped plate (a flood fill over \
 the particles that the cracks do not separate), its mass (g; g per mm of depth in plane strain) \
-and mass-averaged velocity along the impact direction at the end of the run. [RL10]'s values \
+and mass-averaged velocity along the impact direction at the end of the run. Exposed contacts: \
+when particles that started in the interior, and joined the contact slaves once the projectile came \
+within a spacing of them, were pushed by it (first and last history row; — if never). [RL10]'s values \
 exist for its own model only (plane strain, its material).";
 
 #[cfg(test)]

@@ -917,3 +917,80 @@ fn compare_spreading_on_elastic_impact() {
     assert!(sf_b.chatter < 0.5 * id_b.chatter && sf_b.dissipation < 0.3 * id_b.dissipation, "{sf_b:?} vs {id_b:?}");
     assert!(sf.0.iterations < 50 && sf_b.iterations < 50, "Gauss-Seidel converged within the default cap");
 }
+
+// ---------------------------------------------------------------- exposure
+
+/// [`RigidBody::within_reach`]: inside, near a face, and near a corner
+/// (Euclidean distance, not the bounding box) against hand-computed
+/// distances, for a rectangle and a triangle.
+#[test]
+fn within_reach_of_a_rigid_outline() {
+    let at = Vec2::new(0.3, -0.2);
+    let rect = RigidBody::new("r", rectangle_outline(0.02, 0.08), at, Vec2::zeros(), 1.0).unwrap();
+    let y = |x: Real, y: Real| Vec2::new(x, y); // body frame: centre at 0
+    assert!(rect.within_reach(&y(0.0, 0.0), 0.0), "centre");
+    assert!(rect.within_reach(&y(0.0099, -0.0399), 0.0), "just inside a corner");
+    assert!(!rect.within_reach(&y(0.0, -0.0401), 0.0), "just below the face");
+    assert!(rect.within_reach(&y(0.0, -0.0401), 1.01e-4), "within reach below the face");
+    assert!(!rect.within_reach(&y(0.0, -0.0401), 0.99e-4), "beyond reach below the face");
+    // 1e-3 out in x and y from the corner (0.01, -0.04): distance √2·1e-3,
+    // inside the bounding box grown by 1.2e-3 but beyond that reach.
+    assert!(!rect.within_reach(&y(0.011, -0.041), 1.2e-3), "corner, diagonal");
+    assert!(rect.within_reach(&y(0.011, -0.041), 1.5e-3), "corner, within reach");
+    // a triangle: a point in its bounding box but outside the slanted face
+    let tri = RigidBody::new(
+        "t",
+        vec![Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0)],
+        Vec2::zeros(),
+        Vec2::zeros(),
+        1.0,
+    )
+    .unwrap();
+    assert!(tri.within_reach(&y(0.2, 0.2), 0.0), "inside");
+    let d = (0.9 + 0.9 - 1.0) / (2.0 as Real).sqrt(); // distance of (0.9, 0.9) to x + y = 1
+    assert!(!tri.within_reach(&y(0.9, 0.9), 0.99 * d), "outside the slanted face");
+    assert!(tri.within_reach(&y(0.9, 0.9), 1.01 * d), "within reach of the slanted face");
+}
+
+/// Slaves by exposure ([`ContactSystem::admit_exposed`]): of three
+/// particles that are not slaves, the one inside a wall and the one within
+/// a spacing of it join the set (once), the far one does not; a step then
+/// puts both on the wall's surface. With the option off nothing joins and
+/// the particle inside stays there.
+#[test]
+fn exposed_particles_join_the_slaves_and_are_pushed_out() {
+    let dt = 1e-7;
+    let h = 1e-3;
+    let particles = || {
+        let mut p = Particles::default();
+        for (x, y) in [(0.0, 5.0 * h), (0.1, -0.3 * h), (0.2, 0.5 * h), (0.3, 2.5 * h)] {
+            let k = p.push(Vec2::new(x, y), 1e-6, h, 2.0 * h, 293.0, 0, ParticleFlags::default());
+            p.mass[k] = 2e-4;
+        }
+        p.v[2] = Vec2::new(0.0, -8.0 * h / dt); // crosses the surface this step
+        p
+    };
+    let none = ContactParameters { spreading: Spreading::None, ..ContactParameters::default() };
+    assert!(none.admit_exposed, "on by default");
+    let mut p = particles();
+    let mut sys = ContactSystem::new(vec![wall(0.0)], SlaveSet::from_indices([0]), none).unwrap();
+    assert_eq!(sys.admit_exposed(&p.x0, &p.u, &p.spacing), 2);
+    assert_eq!(sys.slaves.particles(), &[0, 1, 2]);
+    assert_eq!(sys.admit_exposed(&p.x0, &p.u, &p.spacing), 0, "members stay, nobody joins twice");
+    let mut f = Vec::new();
+    let r = step(&mut sys, &mut p, None, dt, &mut f);
+    assert_eq!(r.active_contacts, 2);
+    for i in [1, 2] {
+        let y_end = p.x0[i].y + p.u[i].y;
+        assert!(y_end.abs() <= 1e-12 * h, "particle {i} ends at y = {y_end:e}");
+    }
+    assert_eq!(p.u[3], Vec2::zeros(), "the far particle feels nothing");
+
+    let off = ContactParameters { admit_exposed: false, ..none };
+    let mut p = particles();
+    let mut sys = ContactSystem::new(vec![wall(0.0)], SlaveSet::from_indices([0]), off).unwrap();
+    assert_eq!(sys.admit_exposed(&p.x0, &p.u, &p.spacing), 0);
+    let r = step(&mut sys, &mut p, None, dt, &mut f);
+    assert_eq!(r.active_contacts, 0);
+    assert!(p.x0[1].y + p.u[1].y < 0.0, "without exposure the particle inside stays inside");
+}

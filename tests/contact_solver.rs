@@ -1,6 +1,7 @@
 //! Contact inside the real time loop (SPEC §8 with §4–§5): momentum,
 //! impenetrability and an elastic rebound, driven through `Simulation`.
 
+mod common;
 use plugsim::case::Case;
 use plugsim::math::{Real, Vec2};
 use plugsim::run::build_simulation;
@@ -133,4 +134,33 @@ end = 2.0e-5
     // one-step contact force.
     assert!((vcm - 10.0).abs() < 0.5, "rebound speed {vcm:.3} m/s vs 10 m/s");
     assert!(max_total < e0 * 1.005, "energy gained: {max_total:e} > {e0:e}");
+}
+
+/// Slaves by exposure inside the time loop: on the narrow Borvik plate
+/// interior particles under the projectile's face come within a spacing of
+/// it and join the slaves, but none penetrates (the surface layer above
+/// them holds the face), so they get no force and the run has the same
+/// bits as with the option off.
+#[test]
+fn admitted_interior_slaves_that_never_penetrate_change_no_bits() {
+    let run = |admit: &str| {
+        let mut sim = build_simulation(&common::small_borvik_nofracture(&[admit])).unwrap();
+        for _ in 0..150 {
+            sim.step().unwrap();
+        }
+        sim
+    };
+    let (on, off) = (run("contact.admit_exposed=true"), run("contact.admit_exposed=false"));
+    let (con, coff) = (on.contact.as_ref().unwrap(), off.contact.as_ref().unwrap());
+    assert!(
+        con.slaves.len() > coff.slaves.len(),
+        "interior particles should have joined ({} slaves on, {} off)",
+        con.slaves.len(),
+        coff.slaves.len()
+    );
+    let bits = |v: &[Vec2]| v.iter().flat_map(|x| [x.x.to_bits(), x.y.to_bits()]).collect::<Vec<_>>();
+    assert_eq!(bits(&on.model.particles.u), bits(&off.model.particles.u));
+    assert_eq!(bits(&on.model.particles.v), bits(&off.model.particles.v));
+    assert_eq!(con.bodies[0].velocity.y.to_bits(), coff.bodies[0].velocity.y.to_bits());
+    assert!(con.bodies[0].velocity.y > -297.0, "the projectile must be slowed by the plate");
 }

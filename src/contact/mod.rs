@@ -54,6 +54,8 @@
 //! - Contact work with the step-centred displacement increment
 //!   ([`ContactSystem::advance`]).
 //! - Rigid bodies translate only ([`rigid`]).
+//! - Slaves by exposure: interior particles that come within a spacing of
+//!   a rigid body join the slaves ([`ContactSystem::admit_exposed`]).
 
 pub mod force;
 pub mod grid;
@@ -70,6 +72,7 @@ pub use slave::{MasterFeature, Pairing, SlaveSet};
 pub use surface::{detect_surface, SurfaceDetection};
 pub use system::{
     ActiveContact, BodySample, ContactAccumulators, ContactParameters, ContactSystem, StepInput, StepReport,
+    EXPOSED_REACH,
 };
 
 use crate::math::Real;

@@ -167,6 +167,30 @@ impl RigidBody {
         y.x >= self.lower.x && y.x <= self.upper.x && y.y >= self.lower.y && y.y <= self.upper.y
     }
 
+    /// Whether the body-frame point `y` is inside the body or within
+    /// `reach ≥ 0` of its outline (Euclidean distance to the nearest
+    /// segment; the inside by the crossing-number rule).
+    pub fn within_reach(&self, y: &Vec2, reach: Real) -> bool {
+        let r = Vec2::new(reach, reach);
+        let (lo, hi) = (self.lower - r, self.upper + r);
+        if y.x < lo.x || y.x > hi.x || y.y < lo.y || y.y > hi.y {
+            return false;
+        }
+        let n = self.outline.len();
+        let mut inside = false;
+        let mut nearest = Real::INFINITY;
+        for k in 0..n {
+            let (a, b) = (self.outline[k], self.outline[(k + 1) % n]);
+            if (a.y > y.y) != (b.y > y.y) && y.x < a.x + (y.y - a.y) * (b.x - a.x) / (b.y - a.y) {
+                inside = !inside;
+            }
+            let ab = b - a;
+            let t = ((y - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0);
+            nearest = nearest.min((y - (a + ab * t)).norm());
+        }
+        inside || nearest <= reach
+    }
+
     /// Velocity the body will have over the coming step before the contact
     /// reaction is known: the prescribed one, or the current one (the body
     /// carries no other load). Used to predict the master surface (SPEC §8).

@@ -163,14 +163,18 @@
 //!   `fracture.erode_inverted = false`. `history.csv` counts the eroded
 //!   points (`eroded_points`) and the run summary reports them
 //!   (`inverted_failed_points_are_eroded_and_others_stop_the_run`). It
-//!   does not rescue the fine plane-strain Borvik rows with the damage
+//!   did not rescue the fine plane-strain Borvik rows with the damage
 //!   criterion: in both, one corner crack stalls beside material that the
 //!   projectile's corner crushes (particle pressures from tens of GPa up
-//!   to 1.4 TPa), and the point that inverts (Case I at
-//!   35.8 µs, Case II at 37.0 µs) has `D < D_cr` (`docs/validation.md`).
-//!   Eroding every inverted point within `R` of a crack as well was tried
-//!   on Case I: the run then stopped in the same step with a particle at
-//!   14.5 km/s, so that rule was not kept.
+//!   to 1.4 TPa), and the point that inverted (Case I at
+//!   35.8 µs, Case II at 37.0 µs) had `D < D_cr`. Eroding every inverted
+//!   point within `R` of a crack as well was tried on Case I: the run then
+//!   stopped in the same step with a particle at 14.5 km/s, so that rule
+//!   was not kept. The cause was in the contact: the corner had pushed the
+//!   extruded surface layer aside and penetrated interior particles, which
+//!   were not slaves; with slaves by exposure
+//!   ([`crate::contact::ContactSystem::admit_exposed`]) Case I runs to
+//!   118 µs (`docs/validation.md`).
 //! - Crack segments are extended by `5 δ` beyond each end that is not a
 //!   growing tip, so sight lines grazing a split vertex are blocked.
 //! - After a change the internal force is recomputed from the new table
