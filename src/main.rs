@@ -180,17 +180,31 @@ fn main() {
     std::process::exit(code);
 }
 
+/// `plugsim cases`: one line per built-in case and alias. A reader that
+/// stops early (`plugsim cases | head`) ends the listing quietly, as with
+/// other command-line tools, instead of a panic on the closed pipe.
+fn list_cases() -> Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    let lines = BUILTIN_CASES
+        .iter()
+        .map(|(name, _, about)| format!("{name:44} {about}"))
+        .chain(ALIASES.iter().map(|(alias, name)| format!("{alias:44} = {name}")));
+    for line in lines {
+        match writeln!(out, "{line}") {
+            Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => return Ok(()),
+            r => r?,
+        }
+    }
+    match out.flush() {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        r => Ok(r?),
+    }
+}
+
 fn dispatch(cmd: Command) -> Result<()> {
     match cmd {
-        Command::Cases => {
-            for (name, _, about) in BUILTIN_CASES {
-                println!("{name:44} {about}");
-            }
-            for (alias, name) in ALIASES {
-                println!("{alias:44} = {name}");
-            }
-            Ok(())
-        }
+        Command::Cases => list_cases(),
         Command::Bench { case, steps, whole, set } => bench(&case, steps, whole, &set),
         Command::Validate { out, all, only, full_time } => validate(&out, all, only.as_deref(), full_time),
         Command::MaterialPoint { material, case_file, path, rate, strain, dt, out } => {

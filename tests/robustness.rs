@@ -480,3 +480,27 @@ proptest! {
         check_like_the_cli(&text_out, &overrides);
     }
 }
+
+/// `plugsim cases` lists every built-in case and alias, and a reader that
+/// closes the pipe before the listing is written (`plugsim cases | head -0`)
+/// ends it quietly: exit 0, no panic on the closed pipe.
+#[test]
+fn case_listing_survives_a_closed_pipe() {
+    let out = plugsim(&["cases"]);
+    assert!(out.status.success());
+    let listed = String::from_utf8_lossy(&out.stdout).lines().count();
+    assert_eq!(listed, BUILTIN_CASES.len() + plugsim::cases::ALIASES.len());
+    for _ in 0..5 {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_plugsim"))
+            .arg("cases")
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take()); // the reader is gone before the child starts writing
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "exit {:?}: {stderr}", out.status);
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
+}
