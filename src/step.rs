@@ -237,8 +237,9 @@ impl Simulation {
     /// Advance one step `t → t + Δt`. Stages, in order:
     /// 0. contact (SPEC §8): particles the projectile reaches join the slaves
     ///    ([`ContactSystem::admit_exposed`]), then search and one-step forces
-    ///    from the contact-free predictor, which needs this step's `f_int(U^n)` — so contact runs
-    ///    after the previous step's internal force and before integration;
+    ///    from the contact-free predictor, which needs this step's
+    ///    `f_int(U^n)` — so contact runs after the previous step's internal
+    ///    force and before integration;
     /// 1. time integration: `a = (f_ext + f_contact − f_int)/m`, `V ← V + Δt a`,
     ///    `U ← U + Δt V`, constraints (SPEC §5); rigid bodies advance under
     ///    the contact reactions;

@@ -351,7 +351,8 @@ impl ContactSystem {
     /// before they penetrate keeps the contact surface the current one.
     /// A particle that joins and never penetrates gets no force and changes
     /// nothing: runs whose interior particles never reach a body keep their
-    /// bits (test `exposed_particles_join_the_slaves_and_are_pushed_out`).
+    /// bits (tests `exposed_particles_join_the_slaves_and_are_pushed_out`,
+    /// `admitted_interior_slaves_that_never_penetrate_change_no_bits`).
     /// The check is one parallel pass over the particles with a bounding-box
     /// filter per body.
     pub fn admit_exposed(&mut self, x0: &[Vec2], u: &[Vec2], spacing: &[Real]) -> usize {
