@@ -561,13 +561,17 @@ pub fn plot_fields_at(sim: &Simulation, dir: &Path, at: Real) -> Result<Vec<Path
     Ok(written)
 }
 
-/// The perforation time of the run in `dir`: when the plug was first cut
-/// out (the `perforation_time` column of the last `history.csv` row; the
-/// plug is looked for after every step that changed the cracks). `None` if
-/// no plug was cut out.
-pub fn perforation_time(dir: &Path) -> Result<Option<Real>, IoError> {
-    let table = crate::io::HistoryTable::read(&dir.join("history.csv"))?;
-    Ok(table.column("perforation_time").and_then(|c| c.last().copied()).filter(|&t| t > 0.0))
+/// A run's `history.csv` in `dir`, read once for the functions below.
+pub fn read_history(dir: &Path) -> Result<crate::io::HistoryTable, IoError> {
+    crate::io::HistoryTable::read(&dir.join("history.csv"))
+}
+
+/// The perforation time of a run, from its history: when the plug was first
+/// cut out (the `perforation_time` column of the last row; the plug is
+/// looked for after every step that changed the cracks). `None` if no plug
+/// was cut out.
+pub fn perforation_time(table: &crate::io::HistoryTable) -> Option<Real> {
+    table.column("perforation_time").and_then(|c| c.last().copied()).filter(|&t| t > 0.0)
 }
 
 /// When each rigid body was last in contact, from the run's `history.csv`
@@ -576,26 +580,24 @@ pub fn perforation_time(dir: &Path) -> Result<Option<Real>, IoError> {
 /// loop, so it is right for resumed runs too. The velocity a body keeps once
 /// its contacts have vanished is what experimenters call its residual
 /// velocity.
-pub fn last_contact_times(dir: &Path, rigid_names: &[String]) -> Result<Vec<(String, Option<Real>)>, IoError> {
-    let table = crate::io::HistoryTable::read(&dir.join("history.csv"))?;
-    let time = table.column("time").unwrap_or_default().to_vec();
-    Ok(rigid_names
+pub fn last_contact_times(table: &crate::io::HistoryTable, rigid_names: &[String]) -> Vec<(String, Option<Real>)> {
+    let time = table.column("time").unwrap_or_default();
+    rigid_names
         .iter()
         .map(|n| {
             let last = table
                 .column(&format!("{n}_contacts"))
-                .and_then(|c| c.iter().zip(&time).rev().find(|(c, _)| **c > 0.0).map(|(_, t)| *t));
+                .and_then(|c| c.iter().zip(time).rev().find(|(c, _)| **c > 0.0).map(|(_, t)| *t));
             (n.clone(), last)
         })
-        .collect())
+        .collect()
 }
 
 /// Slaves by exposure, from the run's `history.csv`: the particles admitted
 /// by the end (`exposed_slaves` of the last row) and, if any of them
 /// touched a rigid body in a history row, the first and last such row's
 /// time, s, and the most in one row (`exposed_contacts`).
-pub fn exposed_contact_summary(dir: &Path) -> Result<ExposedSummary, IoError> {
-    let table = crate::io::HistoryTable::read(&dir.join("history.csv"))?;
+pub fn exposed_contact_summary(table: &crate::io::HistoryTable) -> ExposedSummary {
     let time = table.column("time").unwrap_or_default();
     let admitted = table.column("exposed_slaves").and_then(|c| c.last().copied()).unwrap_or(0.0) as usize;
     let touching: Vec<(Real, Real)> = table
@@ -608,7 +610,7 @@ pub fn exposed_contact_summary(dir: &Path) -> Result<ExposedSummary, IoError> {
         }
         _ => None,
     };
-    Ok(ExposedSummary { admitted, contacts })
+    ExposedSummary { admitted, contacts }
 }
 
 /// What [`exposed_contact_summary`] reads off the history.
@@ -634,7 +636,7 @@ mod tests {
             h.write_row(&[t, p, 0.0]).unwrap();
         }
         drop(h);
-        let got = last_contact_times(&dir, &["p".into(), "q".into()]).unwrap();
+        let got = last_contact_times(&read_history(&dir).unwrap(), &["p".into(), "q".into()]);
         assert_eq!(got, vec![("p".to_string(), Some(3.0)), ("q".to_string(), None)]);
         std::fs::remove_dir_all(&dir).unwrap();
     }
@@ -648,11 +650,34 @@ mod tests {
             h.write_row(&[t, p]).unwrap();
         }
         drop(h);
-        assert_eq!(perforation_time(&dir).unwrap(), Some(1.7));
+        assert_eq!(perforation_time(&read_history(&dir).unwrap()), Some(1.7));
         let mut h = HistoryWriter::create(&dir.join("history.csv"), &["time", "perforation_time"]).unwrap();
         h.write_row(&[0.0, 0.0]).unwrap();
         drop(h);
-        assert_eq!(perforation_time(&dir).unwrap(), None);
+        assert_eq!(perforation_time(&read_history(&dir).unwrap()), None);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn exposed_contacts_span_the_rows_with_pushed_admitted_particles() {
+        let dir = std::env::temp_dir().join(format!("plugsim-exposed-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut h =
+            HistoryWriter::create(&dir.join("history.csv"), &["time", "exposed_slaves", "exposed_contacts"]).unwrap();
+        for (t, a, n) in
+            [(0.0, 0.0, 0.0), (1.0, 4.0, 0.0), (2.0, 6.0, 2.0), (3.0, 7.0, 0.0), (4.0, 7.0, 3.0), (5.0, 9.0, 0.0)]
+        {
+            h.write_row(&[t, a, n]).unwrap();
+        }
+        drop(h);
+        let got = exposed_contact_summary(&read_history(&dir).unwrap());
+        assert_eq!(got, ExposedSummary { admitted: 9, contacts: Some((2.0, 4.0, 3)) });
+        let mut h =
+            HistoryWriter::create(&dir.join("history.csv"), &["time", "exposed_slaves", "exposed_contacts"]).unwrap();
+        h.write_row(&[0.0, 5.0, 0.0]).unwrap();
+        drop(h);
+        let got = exposed_contact_summary(&read_history(&dir).unwrap());
+        assert_eq!(got, ExposedSummary { admitted: 5, contacts: None });
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

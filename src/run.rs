@@ -474,8 +474,9 @@ fn time_loop(
         .map(|c| c.bodies.iter().map(|b| (b.name.clone(), [b.velocity.x, b.velocity.y])).collect())
         .unwrap_or_default();
     let names: Vec<String> = rigid_velocities.iter().map(|(n, _)| n.clone()).collect();
-    let last_contacts = crate::output::last_contact_times(&cfg.out_dir, &names)?;
-    let perforation = crate::output::perforation_time(&cfg.out_dir)?;
+    let history = crate::output::read_history(&cfg.out_dir)?;
+    let last_contacts = crate::output::last_contact_times(&history, &names);
+    let perforation = crate::output::perforation_time(&history);
     let plug = match (&sim.cracks, crate::output::impact_line(&sim)) {
         (Some(c), Some(axis_x)) => crate::plug::find_plug(&sim.model, c, axis_x),
         _ => None,
@@ -484,7 +485,7 @@ fn time_loop(
         perforation,
         plug,
         eroded_points: sim.model.quad.eroded.iter().filter(|&&e| e).count(),
-        exposed: crate::output::exposed_contact_summary(&cfg.out_dir)?,
+        exposed: crate::output::exposed_contact_summary(&history),
         cracks,
         separation,
         rigid_velocities,
