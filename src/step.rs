@@ -5,7 +5,7 @@ use crate::contact::{ContactError, ContactSystem, StepInput};
 use crate::fracture::{CrackGrowth, FractureError};
 use crate::material::{Constitutive, StepKinematics};
 use crate::math::{is_block_2d, Block2, Real, Tensor3, Vec2};
-use crate::model::{constrain, Model};
+use crate::model::{constrain, Model, PARALLEL_PIECE};
 use crate::particles::ParticleFlags;
 use crate::quadrature::NO_CARRY;
 use crate::thermal::{HeatConduction, HeatError};
@@ -30,7 +30,7 @@ pub enum TimeStepRule {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Energies {
     /// `½ Σ m_I |V_I|²` of the particles at the last full step (see
-    /// `full_step_kinetic_energy`).
+    /// `full_step_kinetic_terms`).
     pub kinetic: Real,
     /// Stress work `∫∫ τ : d dV₀ dt` (elastic energy + plastic dissipation).
     pub internal: Real,
@@ -268,14 +268,24 @@ impl Simulation {
         let th = Instant::now();
         self.conduct_heat(dt)?;
         let t2 = Instant::now();
-        self.internal_force();
+        // The internal energy's increment is summed in point order (the
+        // same bits for any number of threads) on one worker while the
+        // others gather the internal force: the serial sum costs no wall
+        // time of its own.
+        let work = &self.work_scratch;
+        let (increment, ()) = rayon::join(|| work.iter().sum::<Real>(), || internal_force(&mut self.model));
+        self.energies.internal += increment;
         let t3 = Instant::now();
         self.grow_cracks(dt)?;
         let t3c = Instant::now();
         self.time += dt;
         self.step += 1;
-        self.diagnose()?;
-        self.energies.kinetic = self.full_step_kinetic_energy();
+        self.full_step_kinetic_terms();
+        // The checks run beside the kinetic energy's serial sum.
+        let terms = &self.kinetic_scratch;
+        let (health, kinetic) = rayon::join(|| self.diagnose(), || terms.iter().sum::<Real>());
+        health?;
+        self.energies.kinetic = kinetic;
         self.check_energy()?;
         let t4 = Instant::now();
         self.timers.contact += t0 - tc;
@@ -312,7 +322,7 @@ impl Simulation {
             // keeps one entry per particle (a checkpoint written now checks it).
             self.f_contact.resize(self.model.particles.len(), Vec2::zeros());
         }
-        self.internal_force();
+        internal_force(&mut self.model);
         Ok(())
     }
 
@@ -385,20 +395,22 @@ impl Simulation {
     /// `V^{n+1} = V^{n+½} + ½ Δt a^{n+1}` (velocity-Verlet form of the central
     /// difference), so that it is reported at the same instant as the
     /// internal energy, whose state is `τ^{n+1}`. The particles' terms are
-    /// formed in parallel and summed in index order (the same bits for any
-    /// number of threads).
-    fn full_step_kinetic_energy(&mut self) -> Real {
+    /// formed here in parallel into `kinetic_scratch`; `step` sums them in
+    /// index order (the same bits for any number of threads).
+    fn full_step_kinetic_terms(&mut self) {
         let p = &self.model.particles;
         let half = 0.5 * self.dt;
-        let fc = &self.f_contact;
+        // Particles added by a crack split this step carry no contact force.
+        self.f_contact.resize(p.len(), Vec2::zeros());
         self.kinetic_scratch.resize(p.len(), 0.0);
-        self.kinetic_scratch.par_iter_mut().enumerate().for_each(|(i, e)| {
-            let fc = fc.get(i).copied().unwrap_or_else(Vec2::zeros);
-            let mut acc = (p.f_ext[i] + fc - p.f_int[i]) / p.mass[i];
-            constrain(p.flags[i], &mut acc);
-            *e = 0.5 * p.mass[i] * (p.v[i] + acc * half).norm_squared();
-        });
-        self.kinetic_scratch.iter().sum()
+        (self.kinetic_scratch.par_iter_mut(), &p.f_ext, &self.f_contact, &p.f_int, &p.mass, &p.flags, &p.v)
+            .into_par_iter()
+            .with_max_len(PARALLEL_PIECE)
+            .for_each(|(e, fe, fc, fi, m, flags, v)| {
+                let mut acc = (fe + fc - fi) / *m;
+                constrain(*flags, &mut acc);
+                *e = 0.5 * m * (v + acc * half).norm_squared();
+            });
     }
 
     /// Deformation and velocity gradients, material update, `P w`.
@@ -426,6 +438,7 @@ impl Simulation {
             &q.f_carry_slot,
         )
             .into_par_iter()
+            .with_max_len(PARALLEL_PIECE)
             .enumerate()
             .map(|(qi, (f, tau, eps_p, eps_rate, temp, dmg, pw, work, eroded, carry))| {
                 if *eroded {
@@ -499,7 +512,6 @@ impl Simulation {
                 time: self.time + dt,
             });
         }
-        self.energies.internal += self.work_scratch.iter().sum::<Real>();
         Ok(())
     }
 
@@ -524,14 +536,6 @@ impl Simulation {
         Ok(())
     }
 
-    /// `f_int,I = Σ_q (P w)_q ∇N_I(X_q)` (+ hoop term), gathered per particle.
-    fn internal_force(&mut self) {
-        let m = &mut self.model;
-        let mut f_int = std::mem::take(&mut m.particles.f_int);
-        gather_internal_force(m, &mut f_int);
-        m.particles.f_int = f_int;
-    }
-
     /// Catch NaN/Inf and runaway speeds right after the stages that make them.
     ///
     /// One fused pass over the particles finds whether anything is wrong (a
@@ -541,14 +545,21 @@ impl Simulation {
         let p = &self.model.particles;
         let (step, time) = (self.step, self.time);
         let bound2 = self.speed_bound * self.speed_bound;
-        let healthy = (&p.v, &p.f_int)
-            .into_par_iter()
-            .all(|(v, f)| v.norm_squared() <= bound2 && f.x.is_finite() && f.y.is_finite());
+        // Pieces folded without a branch per item (a short-circuiting test
+        // per item cost more than the test itself).
+        let piece = PARALLEL_PIECE;
+        let healthy = (p.v.par_chunks(piece), p.f_int.par_chunks(piece)).into_par_iter().all(|(v, f)| {
+            v.iter()
+                .zip(f)
+                .fold(true, |ok, (v, f)| ok & (v.norm_squared() <= bound2) & f.x.is_finite() & f.y.is_finite())
+        });
         let q = &self.model.quad;
         let scalars = [("plastic strain", &q.eps_p), ("temperature", &q.temperature), ("damage", &q.damage)];
-        let scalars_ok = (&q.eps_p, &q.temperature, &q.damage)
+        let scalars_ok = (q.eps_p.par_chunks(piece), q.temperature.par_chunks(piece), q.damage.par_chunks(piece))
             .into_par_iter()
-            .all(|(a, b, c)| a.is_finite() && b.is_finite() && c.is_finite());
+            .all(|(a, b, c)| {
+                a.iter().zip(b).zip(c).fold(true, |ok, ((a, b), c)| ok & a.is_finite() & b.is_finite() & c.is_finite())
+            });
         if healthy && scalars_ok {
             return Ok(());
         }
@@ -579,13 +590,21 @@ impl Simulation {
     }
 }
 
+/// `f_int,I = Σ_q (P w)_q ∇N_I(X_q)` (+ hoop term) into the particles'
+/// `f_int`, gathered per particle ([`gather_internal_force`]).
+fn internal_force(m: &mut Model) {
+    let mut f_int = std::mem::take(&mut m.particles.f_int);
+    gather_internal_force(m, &mut f_int);
+    m.particles.f_int = f_int;
+}
+
 /// `f_int,I = Σ_q (P w)_q ∇N_I(X_q)` (+ the hoop term in axisymmetry; SPEC
 /// §4) into `f` (one entry per particle): each particle sums its own
 /// entries of the gather in their fixed order, so the result is the same
 /// for any number of threads.
 pub fn gather_internal_force(m: &Model, f: &mut [Vec2]) {
     let (gather, pw, xq, mode) = (&m.gather, &m.quad.pw, &m.quad.x0, m.mode);
-    f.par_iter_mut().enumerate().for_each(|(i, f)| {
+    f.par_iter_mut().with_max_len(PARALLEL_PIECE).enumerate().for_each(|(i, f)| {
         let mut acc = Vec2::zeros();
         for j in gather.range(i) {
             let q = gather.point[j] as usize;

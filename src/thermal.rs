@@ -68,7 +68,7 @@
 
 use crate::material::Constitutive;
 use crate::math::{Real, Tensor3, Vec2};
-use crate::model::Model;
+use crate::model::{Model, PARALLEL_PIECE};
 use nalgebra::Matrix2;
 use rayon::prelude::*;
 
@@ -450,8 +450,11 @@ impl HeatConduction {
     fn flux_pass(&mut self, model: &Model, with_bound: bool) {
         let (tab, temp) = (&model.qp_shape, &model.particles.temperature);
         let s = &mut self.scratch;
-        (s.flux.par_iter_mut(), s.row_norm.par_iter_mut(), &s.kw).into_par_iter().enumerate().for_each(
-            |(q, (flux, norm, kw))| {
+        (s.flux.par_iter_mut(), s.row_norm.par_iter_mut(), &s.kw)
+            .into_par_iter()
+            .with_max_len(PARALLEL_PIECE)
+            .enumerate()
+            .for_each(|(q, (flux, norm, kw))| {
                 if *kw == Matrix2::zeros() {
                     *flux = Vec2::zeros();
                     *norm = 0.0;
@@ -470,8 +473,7 @@ impl HeatConduction {
                 if with_bound {
                     *norm = n;
                 }
-            },
-        );
+            });
     }
 
     /// Per particle: `−(H T)_I / c_I = Σ_q ∇N_I · (q_q w_q) / c_I`, gathered
@@ -482,8 +484,11 @@ impl HeatConduction {
         let bodies = &self.bodies;
         let s = &mut self.scratch;
         let (flux, kw, row_norm) = (&s.flux, &s.kw, &s.row_norm);
-        (s.rate.par_iter_mut(), s.bound.par_iter_mut(), &p.body, &p.mass).into_par_iter().enumerate().for_each(
-            |(i, (rate, bound, b, m))| {
+        (s.rate.par_iter_mut(), s.bound.par_iter_mut(), &p.body, &p.mass)
+            .into_par_iter()
+            .with_max_len(PARALLEL_PIECE)
+            .enumerate()
+            .for_each(|(i, (rate, bound, b, m))| {
                 let Some(t) = bodies.get(*b as usize).and_then(|t| t.as_ref()) else {
                     *rate = 0.0;
                     *bound = 0.0;
@@ -502,8 +507,7 @@ impl HeatConduction {
                 if with_bound {
                     *bound = bnd / c;
                 }
-            },
-        );
+            });
     }
 
     /// One explicit Euler sub-step on the particles of conducting bodies.
