@@ -318,9 +318,6 @@ impl Simulation {
             for i in faces {
                 contact.slaves.add(i);
             }
-            // The new particles carry no contact force this step; the column
-            // keeps one entry per particle (a checkpoint written now checks it).
-            self.f_contact.resize(self.model.particles.len(), Vec2::zeros());
         }
         internal_force(&mut self.model);
         Ok(())
@@ -400,7 +397,9 @@ impl Simulation {
     fn full_step_kinetic_terms(&mut self) {
         let p = &self.model.particles;
         let half = 0.5 * self.dt;
-        // Particles added by a crack split this step carry no contact force.
+        // Particles added by a crack split this step carry no contact force;
+        // the column keeps one entry per particle (a checkpoint written
+        // after the step checks it).
         self.f_contact.resize(p.len(), Vec2::zeros());
         self.kinetic_scratch.resize(p.len(), 0.0);
         (self.kinetic_scratch.par_iter_mut(), &p.f_ext, &self.f_contact, &p.f_int, &p.mass, &p.flags, &p.v)
