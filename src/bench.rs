@@ -106,6 +106,48 @@ pub fn steps(case: &Case, threads: usize, n: usize) -> Result<Vec<Figure>, RunEr
     })
 }
 
+/// The machine's own ceiling for the thread speed-up of [`steps`]:
+/// `copies` independent one-thread runs of the same steps at once (each
+/// its own simulation in its own pool, nothing shared), as aggregate
+/// quadrature-point updates/s. Against the one-thread figure of [`steps`]
+/// the ratio is what the cores give to code that loses nothing to serial
+/// work or imbalance; below `copies`, memory bandwidth, the shared cache
+/// or the clock speed caps the scaling, and no change to the solver's
+/// threading can win that back. The timed windows start together (after
+/// five warm-up steps each).
+pub fn independent_copies(case: &Case, copies: usize, n: usize) -> Result<Figure, RunError> {
+    let sims = (0..copies.max(1)).map(|_| build_simulation(case)).collect::<Result<Vec<_>, _>>()?;
+    let nq = sims[0].model.quad.len() as Real;
+    let start = std::sync::Barrier::new(sims.len());
+    let seconds: Vec<Result<Real, RunError>> = std::thread::scope(|scope| {
+        let runs: Vec<_> = sims
+            .into_iter()
+            .map(|mut sim| {
+                let start = &start;
+                scope.spawn(move || {
+                    with_threads(1, || {
+                        let warm = (0..5).try_for_each(|_| sim.step().map_err(unstable));
+                        // Every copy reaches the barrier, also one that failed.
+                        start.wait();
+                        warm?;
+                        let t = Instant::now();
+                        for _ in 0..n {
+                            sim.step().map_err(unstable)?;
+                        }
+                        Ok(t.elapsed().as_secs_f64())
+                    })
+                })
+            })
+            .collect();
+        runs.into_iter().map(|r| r.join().expect("a benchmark copy panicked")).collect()
+    });
+    let mut rate = 0.0;
+    for s in seconds {
+        rate += nq * n as Real / s?;
+    }
+    Ok(fig(format!("whole steps, {copies} independent one-thread copies at once (sum)"), rate, "qp-updates/s"))
+}
+
 fn unstable(error: crate::step::SolverError) -> RunError {
     RunError::Unstable { error, last_snapshot: "(none: benchmark)".into(), dir: "(none)".into() }
 }

@@ -386,7 +386,7 @@ fn bench(name: &str, steps: usize, whole: Option<f64>, set: &[String]) -> Result
         show(&bench::shape_build(&case, threads)?);
     }
     for threads in [1, all] {
-        for f in bench::force_assembly(&case, threads, 20)? {
+        for f in bench::force_assembly(&case, threads, 200)? {
             show(&f);
         }
     }
@@ -404,6 +404,14 @@ fn bench(name: &str, steps: usize, whole: Option<f64>, set: &[String]) -> Result
         }
     }
     println!("  speed-up 1 -> {all} threads (whole steps): {:.2}x", rates[1] / rates[0]);
+    if all > 1 {
+        let ceiling = bench::independent_copies(&case, all, steps)?;
+        show(&ceiling);
+        println!(
+            "  the machine's ceiling for that speed-up ({all} independent copies against 1 thread): {:.2}x",
+            ceiling.value / rates[0]
+        );
+    }
     if let Some(end) = whole {
         let mut walls = Vec::new();
         for threads in [1, all] {
