@@ -90,14 +90,8 @@ pub fn material_kernel(material: &Material, n: usize) -> Vec<Figure> {
 pub fn steps(case: &Case, threads: usize, n: usize) -> Result<Vec<Figure>, RunError> {
     with_threads(threads, || {
         let mut sim = build_simulation(case)?;
-        for _ in 0..5 {
-            sim.step().map_err(unstable)?;
-        }
-        let t = Instant::now();
-        for _ in 0..n {
-            sim.step().map_err(unstable)?;
-        }
-        let s = t.elapsed().as_secs_f64();
+        warm_up(&mut sim)?;
+        let s = timed_steps(&mut sim, n)?;
         let (nq, np) = (sim.model.quad.len() as Real, sim.model.particles.len() as Real);
         Ok(vec![
             fig(format!("whole steps, {threads} thread(s)"), nq * n as Real / s, "qp-updates/s"),
@@ -126,15 +120,11 @@ pub fn independent_copies(case: &Case, copies: usize, n: usize) -> Result<Figure
                 let start = &start;
                 scope.spawn(move || {
                     with_threads(1, || {
-                        let warm = (0..5).try_for_each(|_| sim.step().map_err(unstable));
+                        let warm = warm_up(&mut sim);
                         // Every copy reaches the barrier, also one that failed.
                         start.wait();
                         warm?;
-                        let t = Instant::now();
-                        for _ in 0..n {
-                            sim.step().map_err(unstable)?;
-                        }
-                        Ok(t.elapsed().as_secs_f64())
+                        timed_steps(&mut sim, n)
                     })
                 })
             })
@@ -148,6 +138,21 @@ pub fn independent_copies(case: &Case, copies: usize, n: usize) -> Result<Figure
     Ok(fig(format!("whole steps, {copies} independent one-thread copies at once (sum)"), rate, "qp-updates/s"))
 }
 
+/// The steps every workload takes before it measures: past the first
+/// contact and the scratch's first sizing.
+fn warm_up(sim: &mut Simulation) -> Result<(), RunError> {
+    (0..5).try_for_each(|_| sim.step().map_err(unstable))
+}
+
+/// Seconds taken by `n` steps.
+fn timed_steps(sim: &mut Simulation, n: usize) -> Result<Real, RunError> {
+    let t = Instant::now();
+    for _ in 0..n {
+        sim.step().map_err(unstable)?;
+    }
+    Ok(t.elapsed().as_secs_f64())
+}
+
 fn unstable(error: crate::step::SolverError) -> RunError {
     RunError::Unstable { error, last_snapshot: "(none: benchmark)".into(), dir: "(none)".into() }
 }
@@ -159,9 +164,7 @@ fn unstable(error: crate::step::SolverError) -> RunError {
 pub fn force_assembly(case: &Case, threads: usize, n: usize) -> Result<Vec<Figure>, RunError> {
     with_threads(threads, || {
         let mut sim = build_simulation(case)?;
-        for _ in 0..5 {
-            sim.step().map_err(unstable)?;
-        }
+        warm_up(&mut sim)?;
         let m = &sim.model;
         let np = m.particles.len();
         let t = Instant::now();
