@@ -245,14 +245,15 @@ pub fn gather_update(case: &Case, threads: usize, n: usize) -> Result<Vec<Figure
 fn scatter(sim: &Simulation) -> Vec<Vec2> {
     let m = &sim.model;
     let np = m.particles.len();
-    let (tab, pw, xq, mode) = (&m.qp_shape, &m.quad.pw, &m.quad.x0, m.mode);
+    let (tab, pw, pw_zz, xq, mode) = (&m.qp_shape, &m.quad.pw, &m.quad.pw_zz, &m.quad.x0, m.mode);
     (0..m.quad.len())
         .into_par_iter()
         .fold(
             || vec![Vec2::zeros(); np],
             |mut acc, q| {
                 for k in tab.range(q) {
-                    acc[tab.index[k] as usize] += mode.internal_force(&pw[q], tab.value[k], &tab.grad[k], &xq[q]);
+                    acc[tab.index[k] as usize] +=
+                        mode.internal_force(&pw[q], pw_zz[q], tab.value[k], &tab.grad[k], &xq[q]);
                 }
                 acc
             },

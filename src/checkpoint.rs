@@ -640,6 +640,7 @@ fn write_payload<W: Write>(
         temperature,
         damage,
         pw,
+        pw_zz,
         f_carry_slot,
         f_carry,
         eroded,
@@ -648,7 +649,8 @@ fn write_payload<W: Write>(
     // `F`, `τ` and `P w` are kept as their block entries; the format stores
     // the full tensors.
     let full = |c: &[Block2]| -> Vec<Tensor3> { c.iter().map(Block2::to_tensor).collect() };
-    let (f, tau, pw) = (full(f), full(tau), full(pw));
+    let pw: Vec<Block2> = pw.iter().zip(pw_zz).map(|(p, zz)| Block2::from_parts(p, *zz)).collect();
+    let (f, tau, pw) = (full(f), full(tau), full(&pw));
     e.section(
         b"QUAD",
         &[
@@ -1044,26 +1046,32 @@ fn restore(all: &Sections, meta: &mut Dec, case: &Case) -> Result<(Simulation, R
     }
 
     let mut d = section(all, b"QUAD", "QUAD")?;
+    // The columns in the file's order (`P w` in the middle, split on load).
+    let (x0, weight, body) = (d.v2s()?, d.f64s()?, d.u32s()?);
+    let f = d.t3s()?.iter().map(Block2::block_part).collect();
+    let tau = d.t3s()?.iter().map(Block2::block_part).collect();
+    let (eps_p, eps_p_rate, temperature, damage) = (d.f64s()?, d.f64s()?, d.f64s()?, d.f64s()?);
+    let pw = d.t3s()?;
+    let (f_carry_slot, eroded) = (d.u32s()?, d.u8s()?.into_iter().map(|b| b != 0).collect());
+    d.finish()?;
+    let mut c = section(all, b"FCAR", "FCAR")?;
+    let f_carry = c.t3s()?;
+    c.finish()?;
     let quad = QuadraturePoints {
-        x0: d.v2s()?,
-        weight: d.f64s()?,
-        body: d.u32s()?,
-        f: d.t3s()?.iter().map(Block2::block_part).collect(),
-        tau: d.t3s()?.iter().map(Block2::block_part).collect(),
-        eps_p: d.f64s()?,
-        eps_p_rate: d.f64s()?,
-        temperature: d.f64s()?,
-        damage: d.f64s()?,
-        pw: d.t3s()?.iter().map(Block2::block_part).collect(),
-        f_carry_slot: d.u32s()?,
-        eroded: d.u8s()?.into_iter().map(|b| b != 0).collect(),
-        f_carry: {
-            d.finish()?;
-            let mut c = section(all, b"FCAR", "FCAR")?;
-            let v = c.t3s()?;
-            c.finish()?;
-            v
-        },
+        x0,
+        weight,
+        body,
+        f,
+        tau,
+        eps_p,
+        eps_p_rate,
+        temperature,
+        damage,
+        pw: pw.iter().map(|t| Block2::block_part(t).in_plane()).collect(),
+        pw_zz: pw.iter().map(|t| t[(2, 2)]).collect(),
+        f_carry_slot,
+        f_carry,
+        eroded,
     };
     let q = &quad;
     same_len(
@@ -1080,6 +1088,7 @@ fn restore(all: &Sections, meta: &mut Dec, case: &Case) -> Result<(Simulation, R
             q.temperature.len(),
             q.damage.len(),
             q.pw.len(),
+            q.pw_zz.len(),
             q.f_carry_slot.len(),
             q.eroded.len(),
         ],

@@ -6,7 +6,7 @@
 //! (index 2) is z in plane strain (`F_zz = 1`) and the hoop direction θ in
 //! axisymmetry (`F_θθ = 1 + u_r/R`, `d_θθ = v_r/r`).
 
-use crate::math::{Block2, Real, Tensor3, Vec2};
+use crate::math::{Block2, InPlane, Real, Tensor3, Vec2};
 use serde::{Deserialize, Serialize};
 
 /// How a 2D section represents the 3D body.
@@ -105,12 +105,14 @@ impl GeometryMode {
 
     /// Force on particle `I` from quadrature point `q`: `f_i = (P w_q)_{iJ}
     /// ∂N_I/∂X_J`, plus in axisymmetry the hoop term `(P w_q)_θθ N_I / R_q`
-    /// on the radial component ([RL10, Eq. (2.31)], SPEC §4).
+    /// on the radial component ([RL10, Eq. (2.31)], SPEC §4); `pw` is the
+    /// in-plane block of `P w_q`, `pw_zz` its out-of-plane entry (read only
+    /// in axisymmetry).
     #[inline]
-    pub fn internal_force(self, pw: &Block2, n: Real, grad_n: &Vec2, x0_q: &Vec2) -> Vec2 {
+    pub fn internal_force(self, pw: &InPlane, pw_zz: Real, n: Real, grad_n: &Vec2, x0_q: &Vec2) -> Vec2 {
         let mut f = Vec2::new(pw.xx * grad_n.x + pw.xy * grad_n.y, pw.yx * grad_n.x + pw.yy * grad_n.y);
         if self == GeometryMode::Axisymmetric {
-            f.x += pw.zz * n / x0_q.x;
+            f.x += pw_zz * n / x0_q.x;
         }
         f
     }

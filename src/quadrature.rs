@@ -2,7 +2,7 @@
 //! cells, each with its weight and its material state, struct-of-arrays.
 
 use crate::material::PointState;
-use crate::math::{Block2, Real, Tensor3, Vec2};
+use crate::math::{Block2, InPlane, Real, Tensor3, Vec2};
 
 /// All quadrature points of all bodies. Index `q` in `0..len()`.
 #[derive(Clone, Debug, Default)]
@@ -31,10 +31,13 @@ pub struct QuadraturePoints {
     /// Johnson–Cook damage.
     pub damage: Vec<Real>,
     /// First Piola–Kirchhoff stress times the weight, `P w_q`, cached for the
-    /// force gather, N·m (per unit depth): its five block entries, the only
-    /// ones the force reads (SPEC §4; 40 bytes a point instead of 72, which
-    /// the gather streams through once per step).
-    pub pw: Vec<Block2>,
+    /// force gather, N·m (per unit depth): its in-plane block, aligned for
+    /// the gather's scattered reads ([`InPlane`]), and its out-of-plane
+    /// entry in [`QuadraturePoints::pw_zz`] (the hoop term of
+    /// axisymmetry): the only entries the force reads (SPEC §4).
+    pub pw: Vec<InPlane>,
+    /// The out-of-plane entry `(P w)_zz` (`θθ` in axisymmetry).
+    pub pw_zz: Vec<Real>,
     /// Where point `q`'s deformation gradient carries a jump over crack
     /// changes: an index into [`QuadraturePoints::f_carry`], or
     /// [`NO_CARRY`]. `F = I + Σ_I u_I ⊗ ∇N_I(X_q) + f_carry[slot]`
@@ -71,7 +74,8 @@ impl QuadraturePoints {
         self.eps_p_rate.push(s.eps_p_rate);
         self.temperature.push(s.temperature);
         self.damage.push(s.damage);
-        self.pw.push(Block2::zeros());
+        self.pw.push(InPlane::default());
+        self.pw_zz.push(0.0);
         self.f_carry_slot.push(NO_CARRY);
         self.eroded.push(false);
     }
@@ -93,6 +97,12 @@ impl QuadraturePoints {
             NO_CARRY => Tensor3::zeros(),
             slot => self.f_carry[slot as usize],
         }
+    }
+
+    /// `P w_q` of point `q` as one block, from its two columns.
+    #[inline]
+    pub fn pw_block(&self, q: usize) -> Block2 {
+        Block2::from_parts(&self.pw[q], self.pw_zz[q])
     }
 
     /// The material state of point `q`, gathered from the columns.
@@ -123,6 +133,7 @@ impl QuadraturePoints {
         p(&mut self.temperature, order);
         p(&mut self.damage, order);
         p(&mut self.pw, order);
+        p(&mut self.pw_zz, order);
         p(&mut self.f_carry_slot, order);
         p(&mut self.eroded, order);
     }

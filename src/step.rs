@@ -3,8 +3,9 @@
 
 use crate::contact::{ContactError, ContactSystem, StepInput};
 use crate::fracture::{CrackGrowth, FractureError};
+use crate::geometry::GeometryMode;
 use crate::material::{Constitutive, StepKinematics};
-use crate::math::{is_block_2d, Block2, Real, Tensor3, Vec2};
+use crate::math::{is_block_2d, Block2, InPlane, Real, Tensor3, Vec2};
 use crate::model::{constrain, Model, PARALLEL_PIECE};
 use crate::particles::ParticleFlags;
 use crate::quadrature::NO_CARRY;
@@ -424,81 +425,105 @@ impl Simulation {
         let (tab, u, v, mode, mats) = (&m.qp_shape, &m.particles.u, &m.particles.v, m.mode, &m.materials);
         let q = &mut m.quad;
         let (carried, x0s, weights, bodies) = (&q.f_carry, &q.x0, &q.weight, &q.body);
-        let bad = (
-            q.f.par_iter_mut(),
-            q.tau.par_iter_mut(),
-            q.eps_p.par_iter_mut(),
-            q.eps_p_rate.par_iter_mut(),
-            q.temperature.par_iter_mut(),
-            q.damage.par_iter_mut(),
-            q.pw.par_iter_mut(),
-            self.work_scratch.par_iter_mut(),
-            q.eroded.par_iter_mut(),
-            &q.f_carry_slot,
-        )
-            .into_par_iter()
-            .with_max_len(PARALLEL_PIECE)
-            .enumerate()
-            .map(|(qi, (f, tau, eps_p, eps_rate, temp, dmg, pw, work, eroded, carry))| {
-                if *eroded {
-                    *work = 0.0;
+        // One point's update, entry `k` of piece `c`; `Some((point, J))` if it
+        // inverts and is not eroded.
+        let point = |c: &mut PieceColumns, k: usize| {
+            let qi = c.first + k;
+            if c.eroded[k] {
+                c.work[k] = 0.0;
+                return None;
+            }
+            let (x0, w, body) = (&x0s[qi], weights[qi], bodies[qi]);
+            // Legend: gu = grad U, gv = grad V (2x2), uq/vq = interpolated U, V
+            // (only read in axisymmetry). The 3x3 algebra works on the five
+            // entries of the block form of 2D kinematics (`Block2`; same
+            // bits as the general products).
+            let (gu, gv) = tab.gradient_pair(qi, u, v);
+            let (uq, vq) = if mode.needs_point_values() {
+                (tab.interpolate(qi, u), tab.interpolate(qi, v))
+            } else {
+                (Vec2::zeros(), Vec2::zeros())
+            };
+            let F_dot = mode.deformation_gradient_2d(&gv, &vq, x0, 0.0);
+            let mut F_new = mode.deformation_gradient_2d(&gu, &uq, x0, 1.0);
+            let carry = c.carry[k];
+            if carry != NO_CARRY {
+                // The jump carried over crack changes (`crate::fracture`).
+                F_new = F_new.add(&Block2::block_part(&carried[carry as usize]));
+            }
+            let J = F_new.determinant();
+            let kin = match PointKinematics::new(&c.f[k], &F_new, &F_dot) {
+                Some(kin) if J > 0.0 && J.is_finite() => kin,
+                _ if erosion.is_some_and(|p| p.point_failed(c.eps_p[k], c.damage[k])) => {
+                    // Inverted after failing: eroded, the run goes on.
+                    c.eroded[k] = true;
+                    c.tau[k] = Block2::zeros();
+                    (c.pw[k], c.pw_zz[k]) = (InPlane::default(), 0.0);
+                    c.work[k] = 0.0;
                     return None;
                 }
-                let (x0, w, body) = (&x0s[qi], &weights[qi], &bodies[qi]);
-                // Legend: gu = grad U, gv = grad V (2x2), uq/vq = interpolated U, V
-                // (only read in axisymmetry). The 3x3 algebra works on the five
-                // entries of the block form of 2D kinematics (`Block2`; same
-                // bits as the general products).
-                let (gu, gv) = tab.gradient_pair(qi, u, v);
-                let (uq, vq) = if mode.needs_point_values() {
-                    (tab.interpolate(qi, u), tab.interpolate(qi, v))
-                } else {
-                    (Vec2::zeros(), Vec2::zeros())
+                _ => return Some((qi, J)),
+            };
+            let old = crate::material::PointState {
+                tau: c.tau[k].to_tensor(),
+                eps_p: c.eps_p[k],
+                eps_p_rate: c.eps_p_rate[k],
+                temperature: c.temperature[k],
+                damage: c.damage[k],
+            };
+            let new = mats[body as usize].update(&old, &StepKinematics { d: kin.d, w: kin.w, dt });
+            let new = if cracking { crate::material::fractured(new) } else { new };
+            // Block-form kinematics keep a block-form stress (the models'
+            // updates are sums and block products of `τ`, `d` and `w`).
+            debug_assert!(is_block_2d(&new.tau), "material update left the block form at point {qi}");
+            let new_tau = Block2::block_part(&new.tau);
+            c.work[k] = 0.5 * c.tau[k].add(&new_tau).ddot(&kin.l.sym()) * dt * w;
+            c.f[k] = F_new;
+            c.tau[k] = new_tau;
+            (c.eps_p[k], c.eps_p_rate[k], c.temperature[k], c.damage[k]) =
+                (new.eps_p, new.eps_p_rate, new.temperature, new.damage);
+            let pw = new_tau.mul_transpose(&kin.f_inv).scale(w);
+            (c.pw[k], c.pw_zz[k]) = (pw.in_plane(), pw.zz);
+            None
+        };
+        // Pieces of points, each swept by a plain loop: cheaper than
+        // handing rayon every point (its per-item search bookkeeping cost
+        // about a tenth of the sweep). A piece stops at its first inverted
+        // point, and the run stops there.
+        let piece = PARALLEL_PIECE;
+        let bad = (
+            q.f.par_chunks_mut(piece),
+            q.tau.par_chunks_mut(piece),
+            q.eps_p.par_chunks_mut(piece),
+            q.eps_p_rate.par_chunks_mut(piece),
+            q.temperature.par_chunks_mut(piece),
+            q.damage.par_chunks_mut(piece),
+            q.pw.par_chunks_mut(piece),
+            q.pw_zz.par_chunks_mut(piece),
+            self.work_scratch.par_chunks_mut(piece),
+            q.eroded.par_chunks_mut(piece),
+            q.f_carry_slot.par_chunks(piece),
+        )
+            .into_par_iter()
+            .enumerate()
+            .map(|(i, (f, tau, eps_p, eps_p_rate, temperature, damage, pw, pw_zz, work, eroded, carry))| {
+                let mut c = PieceColumns {
+                    first: i * piece,
+                    f,
+                    tau,
+                    eps_p,
+                    eps_p_rate,
+                    temperature,
+                    damage,
+                    pw,
+                    pw_zz,
+                    work,
+                    eroded,
+                    carry,
                 };
-                let F_dot = mode.deformation_gradient_2d(&gv, &vq, x0, 0.0);
-                let mut F_new = mode.deformation_gradient_2d(&gu, &uq, x0, 1.0);
-                if *carry != NO_CARRY {
-                    // The jump carried over crack changes (`crate::fracture`).
-                    F_new = F_new.add(&Block2::block_part(&carried[*carry as usize]));
-                }
-                let J = F_new.determinant();
-                let k = match PointKinematics::new(f, &F_new, &F_dot) {
-                    Some(k) if J > 0.0 && J.is_finite() => k,
-                    _ if erosion.is_some_and(|p| p.point_failed(*eps_p, *dmg)) => {
-                        // Inverted after failing: eroded, the run goes on.
-                        *eroded = true;
-                        *tau = Block2::zeros();
-                        *pw = Block2::zeros();
-                        *work = 0.0;
-                        return None;
-                    }
-                    _ => return Some((qi, J)),
-                };
-                let kin = StepKinematics { d: k.d, w: k.w, dt };
-                let old = crate::material::PointState {
-                    tau: tau.to_tensor(),
-                    eps_p: *eps_p,
-                    eps_p_rate: *eps_rate,
-                    temperature: *temp,
-                    damage: *dmg,
-                };
-                let new = mats[*body as usize].update(&old, &kin);
-                let new = if cracking { crate::material::fractured(new) } else { new };
-                // Block-form kinematics keep a block-form stress (the models'
-                // updates are sums and block products of `τ`, `d` and `w`).
-                debug_assert!(is_block_2d(&new.tau), "material update left the block form at point {qi}");
-                let new_tau = Block2::block_part(&new.tau);
-                *work = 0.5 * tau.add(&new_tau).ddot(&k.l.sym()) * dt * w;
-                *f = F_new;
-                *tau = new_tau;
-                *eps_p = new.eps_p;
-                *eps_rate = new.eps_p_rate;
-                *temp = new.temperature;
-                *dmg = new.damage;
-                *pw = new_tau.mul_transpose(&k.f_inv).scale(*w);
-                None
+                (0..c.f.len()).find_map(|k| point(&mut c, k))
             })
-            .find_first(|r| r.is_some())
+            .find_first(Option::is_some)
             .flatten();
         if let Some((point, jacobian)) = bad {
             let x = self.model.quad.x0[point];
@@ -602,15 +627,44 @@ fn internal_force(m: &mut Model) {
 /// entries of the gather in their fixed order, so the result is the same
 /// for any number of threads.
 pub fn gather_internal_force(m: &Model, f: &mut [Vec2]) {
-    let (gather, pw, xq, mode) = (&m.gather, &m.quad.pw, &m.quad.x0, m.mode);
+    match m.mode {
+        GeometryMode::PlaneStrain => gather_in_mode::<false>(m, f),
+        GeometryMode::Axisymmetric => gather_in_mode::<true>(m, f),
+    }
+}
+
+/// [`gather_internal_force`] in one geometry mode (`AXI`: axisymmetric),
+/// so that plane strain's loop reads neither `(P w)_zz`, the values nor
+/// the points' radii.
+fn gather_in_mode<const AXI: bool>(m: &Model, f: &mut [Vec2]) {
+    let mode = if AXI { GeometryMode::Axisymmetric } else { GeometryMode::PlaneStrain };
+    let (gather, pw, pw_zz, xq) = (&m.gather, &m.quad.pw, &m.quad.pw_zz, &m.quad.x0);
     f.par_iter_mut().with_max_len(PARALLEL_PIECE).enumerate().for_each(|(i, f)| {
         let mut acc = Vec2::zeros();
         for j in gather.range(i) {
             let q = gather.point[j] as usize;
-            acc += mode.internal_force(&pw[q], gather.value[j], &gather.grad[j], &xq[q]);
+            let (zz, n, x) = if AXI { (pw_zz[q], gather.value[j], xq[q]) } else { (0.0, 0.0, Vec2::zeros()) };
+            acc += mode.internal_force(&pw[q], zz, n, &gather.grad[j], &x);
         }
         *f = acc;
     });
+}
+
+/// One piece of the quadrature points' columns, as the material sweep
+/// updates them: entry `k` is point `first + k`.
+struct PieceColumns<'a> {
+    first: usize,
+    f: &'a mut [Block2],
+    tau: &'a mut [Block2],
+    eps_p: &'a mut [Real],
+    eps_p_rate: &'a mut [Real],
+    temperature: &'a mut [Real],
+    damage: &'a mut [Real],
+    pw: &'a mut [InPlane],
+    pw_zz: &'a mut [Real],
+    work: &'a mut [Real],
+    eroded: &'a mut [bool],
+    carry: &'a [u32],
 }
 
 /// The kinematics of one quadrature point over a step: `d` and `w` of the
