@@ -640,11 +640,13 @@ fn gather_in_mode<const AXI: bool>(m: &Model, f: &mut [Vec2]) {
     let mode = if AXI { GeometryMode::Axisymmetric } else { GeometryMode::PlaneStrain };
     let (gather, pw, pw_zz, xq) = (&m.gather, &m.quad.pw, &m.quad.pw_zz, &m.quad.x0);
     f.par_iter_mut().with_max_len(PARALLEL_PIECE).enumerate().for_each(|(i, f)| {
+        let r = gather.range(i);
+        let entries = gather.point[r.clone()].iter().zip(&gather.grad[r.clone()]).zip(&gather.value[r]);
         let mut acc = Vec2::zeros();
-        for j in gather.range(i) {
-            let q = gather.point[j] as usize;
-            let (zz, n, x) = if AXI { (pw_zz[q], gather.value[j], xq[q]) } else { (0.0, 0.0, Vec2::zeros()) };
-            acc += mode.internal_force(&pw[q], zz, n, &gather.grad[j], &x);
+        for ((&q, grad), &n) in entries {
+            let q = q as usize;
+            let (zz, n, x) = if AXI { (pw_zz[q], n, xq[q]) } else { (0.0, 0.0, Vec2::zeros()) };
+            acc += mode.internal_force(&pw[q], zz, n, grad, &x);
         }
         *f = acc;
     });
