@@ -32,6 +32,27 @@ fn fig(name: impl Into<String>, value: Real, unit: &'static str) -> Figure {
     Figure { name: name.into(), value, unit }
 }
 
+/// What a whole run of the built-in case `name` to `end` s that took
+/// `wall` s says against \[RL10\]'s published run of the same case
+/// ([`crate::validation::published_run`]): the speed-up where the run
+/// covers the paper's simulated time, else how to make it comparable;
+/// `None` for a case the paper did not time.
+pub fn against_paper(name: &str, end: Real, wall: Real) -> Option<String> {
+    let (paper, simulated) = crate::validation::published_run(name)?;
+    Some(if (end - simulated).abs() <= 1e-6 * simulated {
+        format!(
+            "speed-up over [RL10]'s published run of this case ({paper:.0} s on a 2-core Core 2 Duo): {:.0}x",
+            paper / wall
+        )
+    } else {
+        format!(
+            "[RL10] published {paper:.0} s for {:.0} us of this case: --whole {:e} compares with it",
+            simulated * 1e6,
+            simulated
+        )
+    })
+}
+
 /// Run `f` inside a pool of `threads` threads.
 pub fn with_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
     rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("thread pool").install(f)

@@ -434,6 +434,9 @@ fn bench(name: &str, steps: usize, whole: Option<f64>, set: &[String]) -> Result
                 s.snapshots,
                 s.quadrature_points as f64 * s.steps as f64 / s.loop_wall.as_secs_f64()
             );
+            if let Some(line) = bench::against_paper(name, end, wall) {
+                println!("    {line}");
+            }
         }
         println!("  whole-case speed-up 1 -> {all} threads: {:.2}x", walls[0] / walls[1]);
     }

@@ -52,6 +52,11 @@ pub struct Experiment {
     pub perforation_time: Real,
     /// \[RL10\]'s simulated residuals: (particles, criterion, m/s).
     pub paper: &'static [(usize, &'static str, Real)],
+    /// \[RL10\]'s published wall-clock times of its runs over
+    /// `simulated_time`: (particles, s), on an Intel Core 2 Duo (2 cores,
+    /// 2.83 GHz), effective-strain criterion (the damage criterion "very
+    /// close").
+    pub paper_wall: &'static [(usize, Real)],
 }
 
 /// Tables 1 and 3 of \[RL10\] (`shared/reference/ren-li-2010.toml`).
@@ -69,6 +74,7 @@ pub const EXPERIMENTS: &[Experiment] = &[
             (45984, "damage", 239.6),
             (45984, "effective_strain", 246.1),
         ],
+        paper_wall: &[(11496, 0.92 * 3600.0), (45984, 3.80 * 3600.0)],
     },
     Experiment {
         name: "case-2",
@@ -83,8 +89,26 @@ pub const EXPERIMENTS: &[Experiment] = &[
             (45984, "damage", 116.1),
             (45984, "effective_strain", 109.4),
         ],
+        paper_wall: &[(11496, 1.86 * 3600.0), (45984, 7.1 * 3600.0)],
     },
 ];
+
+/// \[RL10\]'s published run of the built-in case `name` (or of the case
+/// an alias names): `(wall time, s; simulated time, s)`, for its own model
+/// only (plane strain, its material, effective-strain cracks, the coarse
+/// or fine discretization: the runs the paper timed). `None` for any other
+/// case. What `plugsim bench --whole` compares with (issue #7).
+pub fn published_run(name: &str) -> Option<(Real, Real)> {
+    let name = crate::cases::ALIASES.iter().find(|a| a.0 == name).map_or(name, |a| a.1);
+    let case = borvik_family().into_iter().find(|c| c.name() == name)?;
+    if !case.is_papers_model() || case.criterion != "effective_strain" {
+        return None;
+    }
+    let experiment = &EXPERIMENTS[case.experiment as usize - 1];
+    let particles = if case.discretization == "coarse" { 11496 } else { 45984 };
+    let wall = experiment.paper_wall.iter().find(|p| p.0 == particles)?.1;
+    Some((wall, experiment.simulated_time))
+}
 
 /// A validation row: a built-in case of the Børvik family and its experiment.
 #[derive(Clone, Debug)]
@@ -392,6 +416,29 @@ exist for its own model only (plane strain, its material).";
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The paper's timings (`shared/reference/ren-li-2010.toml`) belong to
+    /// its own models with the effective-strain criterion, and to each
+    /// discretization its own.
+    #[test]
+    fn published_runs_are_the_papers_timed_models_only() {
+        assert_eq!(published_run("borvik-1-plane-strain"), Some((0.92 * 3600.0, 118.0e-6)));
+        assert_eq!(published_run("borvik-1"), published_run("borvik-1-plane-strain"));
+        assert_eq!(published_run("borvik-1-plane-strain-fine"), Some((3.80 * 3600.0, 118.0e-6)));
+        assert_eq!(published_run("borvik-2-plane-strain"), Some((1.86 * 3600.0, 216.0e-6)));
+        assert_eq!(published_run("borvik-2-plane-strain-fine"), Some((7.1 * 3600.0, 216.0e-6)));
+        for other in
+            ["borvik-1-plane-strain-damage", "borvik-1-axisymmetric", "borvik-2-axisymmetric-fine", "elastic-strike"]
+        {
+            assert_eq!(published_run(other), None, "{other}");
+        }
+        // The comparison `plugsim bench --whole` prints.
+        let line = crate::bench::against_paper("borvik-1", 118e-6, 20.0).unwrap();
+        assert!(line.contains("3312 s") && line.ends_with(": 166x"), "{line}");
+        let line = crate::bench::against_paper("borvik-1-plane-strain-fine", 30e-6, 20.0).unwrap();
+        assert!(line.contains("13680 s for 118 us") && line.contains("--whole 1.18e-4"), "{line}");
+        assert_eq!(crate::bench::against_paper("borvik-1-axisymmetric", 118e-6, 20.0), None);
+    }
 
     #[test]
     fn every_row_is_a_built_in_case_of_its_experiment() {
