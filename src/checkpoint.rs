@@ -646,11 +646,11 @@ fn write_payload<W: Write>(
         eroded,
     } = &m.quad;
     let eroded_bytes: Vec<u8> = eroded.iter().map(|&e| e as u8).collect();
-    // `F`, `τ` and `P w` are kept as their block entries; the format stores
-    // the full tensors.
+    // `F`, `τ` and `P w` are kept as their block entries (`P w` in two
+    // columns); the format stores the full tensors.
     let full = |c: &[Block2]| -> Vec<Tensor3> { c.iter().map(Block2::to_tensor).collect() };
-    let pw: Vec<Block2> = pw.iter().zip(pw_zz).map(|(p, zz)| Block2::from_parts(p, *zz)).collect();
-    let (f, tau, pw) = (full(f), full(tau), full(&pw));
+    let pw: Vec<Tensor3> = pw.iter().zip(pw_zz).map(|(p, zz)| Block2::from_parts(p, *zz).to_tensor()).collect();
+    let (f, tau) = (full(f), full(tau));
     e.section(
         b"QUAD",
         &[

@@ -170,7 +170,7 @@ pub struct Block2 {
 /// two lines (a five-entry [`Block2`] of 40 bytes straddles a line at
 /// three offsets in eight). The force gather reads `P w` this way
 /// ([`crate::quadrature::QuadraturePoints::pw`]); measured on the fine
-/// Case I's gather, one thread, 1.4× faster than from `Block2`s.
+/// Case I's gather, one thread, 1.2–1.4× faster than from `Block2`s.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(C, align(32))]
 pub struct InPlane {

@@ -74,8 +74,9 @@ impl QuadraturePoints {
         self.eps_p_rate.push(s.eps_p_rate);
         self.temperature.push(s.temperature);
         self.damage.push(s.damage);
-        self.pw.push(InPlane::default());
-        self.pw_zz.push(0.0);
+        let pw = Block2::zeros();
+        self.pw.push(pw.in_plane());
+        self.pw_zz.push(pw.zz);
         self.f_carry_slot.push(NO_CARRY);
         self.eroded.push(false);
     }

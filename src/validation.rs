@@ -24,7 +24,7 @@
 //!   direction.
 
 use crate::case::Case;
-use crate::cases::{borvik_family, builtin_case, BorvikCase};
+use crate::cases::{borvik_family, builtin_case, resolve_alias, BorvikCase};
 use crate::io::{HistoryTable, LinePlot, Series};
 use crate::math::Real;
 use crate::run::{execute, RunConfig, RunError, RunInfo, RunSummary};
@@ -99,14 +99,13 @@ pub const EXPERIMENTS: &[Experiment] = &[
 /// or fine discretization: the runs the paper timed). `None` for any other
 /// case. What `plugsim bench --whole` compares with (issue #7).
 pub fn published_run(name: &str) -> Option<(Real, Real)> {
-    let name = crate::cases::ALIASES.iter().find(|a| a.0 == name).map_or(name, |a| a.1);
+    let name = resolve_alias(name);
     let case = borvik_family().into_iter().find(|c| c.name() == name)?;
     if !case.is_papers_model() || case.criterion != "effective_strain" {
         return None;
     }
     let experiment = &EXPERIMENTS[case.experiment as usize - 1];
-    let particles = if case.discretization == "coarse" { 11496 } else { 45984 };
-    let wall = experiment.paper_wall.iter().find(|p| p.0 == particles)?.1;
+    let wall = experiment.paper_wall.iter().find(|p| p.0 == case.paper_particles())?.1;
     Some((wall, experiment.simulated_time))
 }
 
@@ -140,7 +139,7 @@ pub fn coarse_rows() -> Vec<Row> {
 /// (or the case an alias such as `borvik-1` names) if there is one, else
 /// every row whose name contains `TEXT`.
 pub fn select(rows: Vec<Row>, only: &str) -> Vec<Row> {
-    let target = crate::cases::ALIASES.iter().find(|a| a.0 == only).map_or(only, |a| a.1);
+    let target = resolve_alias(only);
     if rows.iter().any(|r| r.id == target) {
         rows.into_iter().filter(|r| r.id == target).collect()
     } else {
@@ -180,7 +179,7 @@ impl Outcome {
         if !self.row.case.is_papers_model() {
             return None;
         }
-        let particles = if self.row.case.discretization == "coarse" { 11496 } else { 45984 };
+        let particles = self.row.case.paper_particles();
         self.row.experiment.paper.iter().find(|p| p.0 == particles && p.1 == self.row.case.criterion).map(|p| p.2)
     }
 
