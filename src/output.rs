@@ -8,9 +8,10 @@
 //! [`Model::project`]).
 
 use crate::io::{write_vtu, DataArray, HistoryWriter, IoError, PvdSeries, VtuPiece};
-use crate::math::{mean_stress, von_mises, Real, Tensor3, Vec2};
+use crate::math::{mean_stress, von_mises, Block2, Real, Tensor3, Vec2};
 use crate::model::Model;
 use crate::step::Simulation;
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// Columns of the history CSV that every run has, in order: time, step,
@@ -83,6 +84,17 @@ pub struct OutputWriter {
     last_contact: Option<Real>,
     /// Step of the last history row (a step gets at most one).
     last_row_step: Option<u64>,
+    /// The last snapshot, while its files are written on a thread of their
+    /// own ([`OutputWriter::snapshot`]).
+    pending: Option<PendingSnapshot>,
+}
+
+/// A snapshot being written beside the time loop: the writing thread and
+/// the series entries (time, file, part) to add once its files are on disk.
+#[derive(Debug)]
+struct PendingSnapshot {
+    writer: std::thread::JoinHandle<Result<(), IoError>>,
+    entries: Vec<(Real, String, u32)>,
 }
 
 impl OutputWriter {
@@ -101,6 +113,7 @@ impl OutputWriter {
             plug: Default::default(),
             last_contact: None,
             last_row_step: None,
+            pending: None,
         })
     }
 
@@ -163,6 +176,7 @@ impl OutputWriter {
             plug: crate::plug::PlugTracker::continuing(first_cut),
             last_contact: None,
             last_row_step,
+            pending: None,
         };
         let log = dir.join("cracks.csv");
         match cracks {
@@ -196,19 +210,53 @@ impl OutputWriter {
         &self.dir
     }
 
-    /// Write `particles_NNNNN.vtu` for the current state and add it to the series.
+    /// Write `particles_NNNNN.vtu` (and `cracks_NNNNN.vtu`) for the current
+    /// state and add them to the series.
+    ///
+    /// The fields are gathered here, from the state as it is now; the files
+    /// are encoded and written on a thread of their own while the run goes
+    /// on (the time loop's serial stages leave a core free for it). One
+    /// snapshot is in flight at a time: the next snapshot, a checkpoint
+    /// ([`OutputWriter::flush`]) and the end of the run wait for it, and a
+    /// file joins `results.pvd` only once it is on disk, so an interrupted
+    /// or failed run lists only complete files. Returns the particle file's path.
     pub fn snapshot(&mut self, sim: &Simulation) -> Result<PathBuf, IoError> {
+        self.flush()?;
         let name = snapshot_name(self.snapshots);
         let path = self.dir.join(&name);
-        write_vtu(&path, &particle_piece(&sim.model, &self.fields))?;
-        self.series.append(sim.time, &name, 0)?;
+        let mut files = vec![(path.clone(), particle_piece(&sim.model, &self.fields))];
+        let mut entries = vec![(sim.time, name, 0)];
         if let Some(cracks) = &sim.cracks {
             let crack_name = crack_snapshot_name(self.snapshots);
-            write_vtu(&self.dir.join(&crack_name), &crack_piece(&sim.model, cracks))?;
-            self.series.append(sim.time, &crack_name, 1)?;
+            files.push((self.dir.join(&crack_name), crack_piece(&sim.model, cracks)));
+            entries.push((sim.time, crack_name, 1));
         }
+        let writer = std::thread::Builder::new()
+            .name("plugsim-snapshot".into())
+            .spawn(move || files.iter().try_for_each(|(path, piece)| write_vtu(path, piece)))
+            .map_err(|source| IoError::Write { path: path.clone(), source })?;
+        self.pending = Some(PendingSnapshot { writer, entries });
         self.snapshots += 1;
         Ok(path)
+    }
+
+    /// Wait for the snapshot being written, if any, and add its files to
+    /// `results.pvd`.
+    pub fn flush(&mut self) -> Result<(), IoError> {
+        let Some(PendingSnapshot { writer, entries }) = self.pending.take() else {
+            return Ok(());
+        };
+        let written = writer.join().unwrap_or_else(|_| {
+            Err(IoError::Write {
+                path: self.dir.join(&entries[0].1),
+                source: std::io::Error::other("the snapshot writer panicked"),
+            })
+        });
+        written?;
+        for (time, file, part) in entries {
+            self.series.append(time, &file, part)?;
+        }
+        Ok(())
     }
 
     /// Append one history row (none if this step has one already).
@@ -258,6 +306,14 @@ impl OutputWriter {
             }
         }
         self.history.write_row(&row)
+    }
+}
+
+impl Drop for OutputWriter {
+    /// A run that ends by an error elsewhere still finishes (and lists) the
+    /// snapshot it started.
+    fn drop(&mut self) {
+        let _ = self.flush();
     }
 }
 
@@ -362,14 +418,54 @@ fn v3(v: &Vec2) -> [f64; 3] {
     [v.x, v.y, 0.0]
 }
 
+/// Per-point values projected together by [`particle_piece`]: the five
+/// entries of the Cauchy stress's block form (`xx, xy, yx, yy, zz`), then
+/// the scalar columns of [`SCALAR_FIELDS`].
+const PROJECTED: usize = 5 + SCALAR_FIELDS.len();
+
+/// The quadrature-point scalars a snapshot can carry, by field name.
+const SCALAR_FIELDS: [&str; 4] = ["plastic_strain", "plastic_strain_rate", "temperature", "damage"];
+
+/// Several quadrature fields projected in one pass over the gather table
+/// ([`Model::project`] of a fixed-size row): each entry gets the same
+/// operations, in the same order, as projecting it on its own.
+#[derive(Clone, Copy, Debug)]
+struct Row<const N: usize>([Real; N]);
+
+impl<const N: usize> Default for Row<N> {
+    fn default() -> Self {
+        Row([0.0; N])
+    }
+}
+
+impl<const N: usize> std::ops::Add for Row<N> {
+    type Output = Row<N>;
+    #[inline]
+    fn add(self, b: Row<N>) -> Row<N> {
+        Row(std::array::from_fn(|k| self.0[k] + b.0[k]))
+    }
+}
+
+impl<const N: usize> std::ops::Mul<Real> for Row<N> {
+    type Output = Row<N>;
+    #[inline]
+    fn mul(self, s: Real) -> Row<N> {
+        Row(self.0.map(|x| x * s))
+    }
+}
+
 /// The particle cloud with the requested fields.
+///
+/// The quadrature fields a snapshot asks for are projected in one pass
+/// over the gather table, with each point's Cauchy stress `τ/J` formed
+/// once (not once per particle it reaches): the same bits as projecting
+/// each field on its own, in a fifth of the passes.
 pub fn particle_piece(model: &Model, fields: &[String]) -> VtuPiece {
     let p = &model.particles;
     let u = model.physical(&p.u);
     let points = (0..p.len()).map(|i| v3(&(p.x0[i] + u[i]))).collect();
     let mut piece = VtuPiece::point_cloud(points);
     let q = &model.quad;
-    let cauchy = |k: usize| q.tau[k].to_tensor() / q.f[k].determinant();
     let want = |name: &str| fields.iter().any(|f| f == name);
     if want("displacement") {
         piece = piece.with_point_data(DataArray::vectors("displacement", &u.iter().map(v3).collect::<Vec<_>>()));
@@ -378,29 +474,46 @@ pub fn particle_piece(model: &Model, fields: &[String]) -> VtuPiece {
         let v = model.physical(&p.v);
         piece = piece.with_point_data(DataArray::vectors("velocity", &v.iter().map(v3).collect::<Vec<_>>()));
     }
-    if want("stress") || want("effective_stress") || want("pressure") {
-        let s: Vec<Tensor3> = model.project(cauchy);
-        if want("stress") {
-            let six: Vec<[f64; 6]> =
-                s.iter().map(|t| [t[(0, 0)], t[(1, 1)], t[(2, 2)], t[(0, 1)], t[(1, 2)], t[(0, 2)]]).collect();
-            piece = piece.with_point_data(DataArray::symmetric_tensors("stress", &six));
+    let stress_wanted = want("stress") || want("effective_stress") || want("pressure");
+    if stress_wanted || SCALAR_FIELDS.iter().any(|f| want(f)) {
+        let columns: [&[Real]; 4] = [&q.eps_p, &q.eps_p_rate, &q.temperature, &q.damage];
+        // Per point: Cauchy `τ/J` entry by entry (as `Tensor3 / J`), then the scalars.
+        let values: Vec<Row<PROJECTED>> = (0..q.len())
+            .into_par_iter()
+            .map(|k| {
+                let (t, j) = (&q.tau[k], q.f[k].determinant());
+                let mut row = [t.xx / j, t.xy / j, t.yx / j, t.yy / j, t.zz / j, 0.0, 0.0, 0.0, 0.0];
+                for (slot, col) in row[5..].iter_mut().zip(columns) {
+                    *slot = col[k];
+                }
+                Row(row)
+            })
+            .collect();
+        let projected = model.project(|k| values[k]);
+        if stress_wanted {
+            let s: Vec<Tensor3> = projected
+                .iter()
+                .map(|r| Block2 { xx: r.0[0], xy: r.0[1], yx: r.0[2], yy: r.0[3], zz: r.0[4] }.to_tensor())
+                .collect();
+            if want("stress") {
+                let six: Vec<[f64; 6]> =
+                    s.iter().map(|t| [t[(0, 0)], t[(1, 1)], t[(2, 2)], t[(0, 1)], t[(1, 2)], t[(0, 2)]]).collect();
+                piece = piece.with_point_data(DataArray::symmetric_tensors("stress", &six));
+            }
+            if want("effective_stress") {
+                piece =
+                    piece.with_point_data(DataArray::scalars("effective_stress", s.iter().map(von_mises).collect()));
+            }
+            if want("pressure") {
+                piece =
+                    piece.with_point_data(DataArray::scalars("pressure", s.iter().map(|t| -mean_stress(t)).collect()));
+            }
         }
-        if want("effective_stress") {
-            piece = piece.with_point_data(DataArray::scalars("effective_stress", s.iter().map(von_mises).collect()));
-        }
-        if want("pressure") {
-            piece = piece.with_point_data(DataArray::scalars("pressure", s.iter().map(|t| -mean_stress(t)).collect()));
-        }
-    }
-    let scalar_fields: [(&str, &[Real]); 4] = [
-        ("plastic_strain", &q.eps_p),
-        ("plastic_strain_rate", &q.eps_p_rate),
-        ("temperature", &q.temperature),
-        ("damage", &q.damage),
-    ];
-    for (name, col) in scalar_fields {
-        if want(name) {
-            piece = piece.with_point_data(DataArray::scalars(name, model.project(|k| col[k])));
+        for (c, name) in SCALAR_FIELDS.iter().enumerate() {
+            if want(name) {
+                piece =
+                    piece.with_point_data(DataArray::scalars(*name, projected.iter().map(|r| r.0[5 + c]).collect()));
+            }
         }
     }
     if want("mass") {

@@ -341,10 +341,11 @@ struct Schedule {
 fn save_checkpoint(
     case: &Case,
     sim: &Simulation,
-    out: &OutputWriter,
+    out: &mut OutputWriter,
     schedule: &Schedule,
     dir: &Path,
 ) -> Result<PathBuf, RunError> {
+    out.flush()?;
     out.sync()?;
     let progress = RunProgress {
         snapshot_times: out.snapshot_times(),
@@ -428,7 +429,7 @@ fn time_loop(
                 }
             }
             let t = Instant::now();
-            let path = save_checkpoint(case, &sim, &out, &schedule, &cfg.out_dir)?;
+            let path = save_checkpoint(case, &sim, &mut out, &schedule, &cfg.out_dir)?;
             output_wall += t.elapsed();
             last_checkpoint = Instant::now();
             progress(Progress::Checkpoint { sim: &sim, path: &path });
@@ -445,6 +446,7 @@ fn time_loop(
         out.crack_events(&sim)?;
         if let Err(error) = stepped {
             let last = out.snapshot(&sim)?;
+            out.flush()?;
             out.history_row(&sim)?;
             return Err(RunError::Unstable { error, last_snapshot: last, dir: cfg.out_dir.clone() });
         }
@@ -455,6 +457,9 @@ fn time_loop(
             progress(Progress::Step { sim: &sim });
         }
     }
+    let t = Instant::now();
+    out.flush()?;
+    output_wall += t.elapsed();
     let loop_wall = t_loop.elapsed().saturating_sub(output_wall);
     progress(Progress::Finished { sim: &sim });
     let t = Instant::now();

@@ -69,6 +69,7 @@
 use crate::material::Constitutive;
 use crate::math::{Real, Tensor3, Vec2};
 use crate::model::{Model, PARALLEL_PIECE};
+use crate::shape::ShapeTable;
 use nalgebra::Matrix2;
 use rayon::prelude::*;
 
@@ -257,11 +258,14 @@ impl HeatConduction {
     /// three orders of magnitude); then the sub-step is the same and so is
     /// every bit of the result, and the report gives the cruder step.
     pub fn conduct(&mut self, model: &mut Model, dt: Real) -> Result<HeatReport, HeatError> {
-        self.prepare(model)?;
+        // The first sub-step's point pass also forms `κ J C⁻¹ w_q` and the
+        // largest row sum the quick step needs: one pass over the points
+        // instead of three, the same values.
+        self.size_scratch(model);
         self.project(model);
-        let quick_dt = self.quick_stable_step(model);
+        let k_hat = self.prepare_with_flux(model)?;
+        let quick_dt = self.quick_step_from(model, k_hat);
         let stable_dt = if dt <= quick_dt {
-            self.flux_pass(model, false);
             self.gather_pass(model, false);
             quick_dt
         } else {
@@ -318,11 +322,13 @@ impl HeatConduction {
     pub fn quick_stable_step(&mut self, model: &Model) -> Real {
         let k_hat = (&self.scratch.kw, &model.quad.weight)
             .into_par_iter()
-            .map(|(k, w)| {
-                let row = (k[(0, 0)].abs() + k[(0, 1)].abs()).max(k[(1, 0)].abs() + k[(1, 1)].abs());
-                row / w
-            })
+            .map(|(k, w)| row_sum(k) / w)
             .reduce(|| 0.0, Real::max);
+        self.quick_step_from(model, k_hat)
+    }
+
+    /// [`Self::quick_stable_step`] given `k̂ = max_q ‖κ J C⁻¹‖_∞`.
+    fn quick_step_from(&mut self, model: &Model, k_hat: Real) -> Real {
         let signature = ReferenceSignature::of(model);
         let reference = match self.reference {
             Some((sig, r)) if sig == signature => r,
@@ -384,8 +390,8 @@ impl HeatConduction {
         }
     }
 
-    /// Size scratch, compute `κ J C⁻¹ w_q` per point.
-    fn prepare(&mut self, model: &Model) -> Result<(), HeatError> {
+    /// Size the scratch columns for the model; zero the increments.
+    fn size_scratch(&mut self, model: &Model) {
         let (np, nq) = (model.particles.len(), model.quad.len());
         let s = &mut self.scratch;
         s.kw.resize(nq, Matrix2::zeros());
@@ -395,26 +401,57 @@ impl HeatConduction {
             v.resize(np, 0.0);
         }
         s.delta.iter_mut().for_each(|d| *d = 0.0);
+    }
+
+    /// Size scratch, compute `κ J C⁻¹ w_q` per point.
+    fn prepare(&mut self, model: &Model) -> Result<(), HeatError> {
+        self.size_scratch(model);
+        self.point_pass(model, false).map(|_| ())
+    }
+
+    /// [`Self::prepare`] and the first [`Self::flux_pass`] (without the
+    /// bound) in one pass over the points, from the projected particle
+    /// temperatures; returns `k̂ = max_q ‖κ J C⁻¹‖_∞` (as
+    /// [`Self::quick_stable_step`] forms it).
+    fn prepare_with_flux(&mut self, model: &Model) -> Result<Real, HeatError> {
+        self.point_pass(model, true)
+    }
+
+    /// Per point, `κ J C⁻¹ w_q` and, `with_flux`, the weighted nominal flux;
+    /// returns `k̂`, or the first point (in index order) whose `F` is not
+    /// invertible.
+    fn point_pass(&mut self, model: &Model, with_flux: bool) -> Result<Real, HeatError> {
+        let (tab, temp) = (&model.qp_shape, &model.particles.temperature);
         let bodies = &self.bodies;
         let q = &model.quad;
-        let bad = (s.kw.par_iter_mut(), &q.f, &q.weight, &q.body)
+        let s = &mut self.scratch;
+        let piece = PARALLEL_PIECE;
+        let (bad, k_hat) = (s.kw.par_chunks_mut(piece), s.flux.par_chunks_mut(piece))
             .into_par_iter()
             .enumerate()
-            .map(|(qi, (kw, f, w, b))| {
-                match bodies.get(*b as usize).and_then(|t| t.as_ref()) {
-                    None => *kw = Matrix2::zeros(),
-                    Some(t) => match reference_conductivity(&f.to_tensor(), t.conductivity) {
-                        Some(k) => *kw = k * *w,
-                        None => return Some((qi, f.determinant())),
-                    },
+            .map(|(c, (kws, fluxes))| {
+                let mut k_hat: Real = 0.0;
+                for (k, (kw, flux)) in kws.iter_mut().zip(fluxes).enumerate() {
+                    let qi = c * piece + k;
+                    let (f, w) = (&q.f[qi], q.weight[qi]);
+                    match bodies.get(q.body[qi] as usize).and_then(|t| t.as_ref()) {
+                        None => *kw = Matrix2::zeros(),
+                        Some(t) => match reference_conductivity(&f.to_tensor(), t.conductivity) {
+                            Some(m) => *kw = m * w,
+                            None => return (Some((qi, f.determinant())), k_hat),
+                        },
+                    }
+                    k_hat = k_hat.max(row_sum(kw) / w);
+                    if with_flux {
+                        *flux = point_flux(tab, temp, qi, kw, false).0;
+                    }
                 }
-                None
+                (None, k_hat)
             })
-            .find_first(|r| r.is_some())
-            .flatten();
+            .reduce(|| (None, 0.0), |a, b| (a.0.or(b.0), a.1.max(b.1)));
         match bad {
             Some((point, jacobian)) => Err(HeatError::Inverted { point, jacobian }),
-            None => Ok(()),
+            None => Ok(k_hat),
         }
     }
 
@@ -455,22 +492,9 @@ impl HeatConduction {
             .with_max_len(PARALLEL_PIECE)
             .enumerate()
             .for_each(|(q, (flux, norm, kw))| {
-                if *kw == Matrix2::zeros() {
-                    *flux = Vec2::zeros();
-                    *norm = 0.0;
-                    return;
-                }
-                let mut grad = Vec2::zeros();
-                let mut n = 0.0;
-                for k in tab.range(q) {
-                    let g = tab.grad[k];
-                    grad += g * temp[tab.index[k] as usize];
-                    if with_bound {
-                        n += kw_norm(kw, &g);
-                    }
-                }
-                *flux = -(kw * grad);
-                if with_bound {
+                let (f, n) = point_flux(tab, temp, q, kw, with_bound);
+                *flux = f;
+                if with_bound || *kw == Matrix2::zeros() {
                     *norm = n;
                 }
             });
@@ -557,6 +581,32 @@ impl HeatConduction {
 #[inline]
 fn conducts(bodies: &[Option<BodyThermal>], b: u32) -> bool {
     matches!(bodies.get(b as usize), Some(Some(_)))
+}
+
+/// Point `q`'s weighted nominal flux `−(κ J C⁻¹ w_q) ∇_X T` from the
+/// particle temperatures `temp`, and, `with_bound`, `Σ_J |∇N_J|_{Kw}`
+/// (zero flux and bound where `kw` is zero: a non-conducting point).
+#[inline]
+fn point_flux(tab: &ShapeTable, temp: &[Real], q: usize, kw: &Matrix2<Real>, with_bound: bool) -> (Vec2, Real) {
+    if *kw == Matrix2::zeros() {
+        return (Vec2::zeros(), 0.0);
+    }
+    let mut grad = Vec2::zeros();
+    let mut n = 0.0;
+    for k in tab.range(q) {
+        let g = tab.grad[k];
+        grad += g * temp[tab.index[k] as usize];
+        if with_bound {
+            n += kw_norm(kw, &g);
+        }
+    }
+    (-(kw * grad), n)
+}
+
+/// The largest absolute row sum `‖k‖_∞` of a 2×2 block.
+#[inline]
+fn row_sum(k: &Matrix2<Real>) -> Real {
+    (k[(0, 0)].abs() + k[(0, 1)].abs()).max(k[(1, 0)].abs() + k[(1, 1)].abs())
 }
 
 /// `|g|_K = sqrt(gᵀ K g)`.
