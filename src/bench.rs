@@ -121,6 +121,44 @@ pub fn steps(case: &Case, threads: usize, n: usize) -> Result<Vec<Figure>, RunEr
     })
 }
 
+/// What the material stage costs without plasticity: `n` steps timed on
+/// the case's model after stepping to `warm_until` s of response (so that
+/// the impact zone flows and heats), first as the case is, then with every Johnson–Cook body made
+/// hypoelastic with the same density, moduli and thermal constants
+/// ([`Material::elastic_twin`]). The second figure is the sweep's cost
+/// without the plasticity: reading the shape table, the kinematics, the
+/// elastic trial and the state's loads and stores — the part that no
+/// faster Johnson–Cook update can remove. Both as nanoseconds of the
+/// stage per point update, with `threads` threads (times `threads`: core
+/// time per update).
+pub fn material_floor(case: &Case, threads: usize, warm_until: Real, n: usize) -> Result<Vec<Figure>, RunError> {
+    with_threads(threads, || {
+        let mut sim = build_simulation(case)?;
+        while sim.time < warm_until {
+            sim.step().map_err(unstable)?;
+        }
+        let per_update = |sim: &mut Simulation| -> Result<Real, RunError> {
+            let before = sim.timers.material;
+            (0..n).try_for_each(|_| sim.step().map_err(unstable))?;
+            let stage = (sim.timers.material - before).as_secs_f64();
+            Ok(stage * threads as Real * 1e9 / (sim.model.quad.len() * n) as Real)
+        };
+        let plastic = per_update(&mut sim)?;
+        for m in sim.model.materials.iter_mut() {
+            *m = m.elastic_twin();
+        }
+        let elastic = per_update(&mut sim)?;
+        Ok(vec![
+            fig(format!("material stage as the case is, {threads} thread(s)"), plastic, "core-ns/qp-update"),
+            fig(
+                format!("material stage, plate made elastic (the floor), {threads} thread(s)"),
+                elastic,
+                "core-ns/qp-update",
+            ),
+        ])
+    })
+}
+
 /// The machine's own ceiling for the thread speed-up of [`steps`]:
 /// `copies` independent one-thread runs of the same steps at once (each
 /// its own simulation in its own pool, nothing shared), as aggregate

@@ -112,6 +112,25 @@ pub enum Material {
     JohnsonCook(JohnsonCook),
 }
 
+impl Material {
+    /// The hypoelastic material with this one's density, moduli, room
+    /// temperature and thermal constants (itself if already elastic): what
+    /// the model would be without plasticity, thermal softening or damage.
+    /// For measurements (`plugsim bench`'s material floor) and tests.
+    pub fn elastic_twin(&self) -> Material {
+        match self {
+            Material::Elastic(_) => self.clone(),
+            Material::JohnsonCook(m) => Material::Elastic(Elastic {
+                density: m.density,
+                youngs_modulus: m.youngs_modulus,
+                poisson_ratio: m.poisson_ratio,
+                room_temperature: m.room_temperature,
+                thermal: m.thermal(),
+            }),
+        }
+    }
+}
+
 impl Constitutive for Material {
     #[inline]
     fn update(&self, old: &PointState, k: &StepKinematics) -> PointState {
