@@ -123,9 +123,9 @@ pub fn steps(case: &Case, threads: usize, n: usize) -> Result<Vec<Figure>, RunEr
 
 /// What the material stage costs without plasticity: `n` steps timed on
 /// the case's model after stepping to `warm_until` s of response (so that
-/// the impact zone flows and heats), first as the case is, then with every Johnson–Cook body made
-/// hypoelastic with the same density, moduli and thermal constants
-/// ([`Material::elastic_twin`]). The second figure is the sweep's cost
+/// the impact zone flows and heats), first as the case is, then with
+/// every Johnson–Cook body made hypoelastic with the same density, moduli
+/// and thermal constants ([`Material::elastic_twin`]). The second figure is the sweep's cost
 /// without the plasticity: reading the shape table, the kinematics, the
 /// elastic trial and the state's loads and stores — the part that no
 /// faster Johnson–Cook update can remove. Both as nanoseconds of the

@@ -420,11 +420,8 @@ fn v3(v: &Vec2) -> [f64; 3] {
 
 /// Per-point values projected together by [`particle_piece`]: the five
 /// entries of the Cauchy stress's block form (`xx, xy, yx, yy, zz`), then
-/// the scalar columns of [`SCALAR_FIELDS`].
-const PROJECTED: usize = 5 + SCALAR_FIELDS.len();
-
-/// The quadrature-point scalars a snapshot can carry, by field name.
-const SCALAR_FIELDS: [&str; 4] = ["plastic_strain", "plastic_strain_rate", "temperature", "damage"];
+/// the four quadrature-point scalars a snapshot can carry.
+const PROJECTED: usize = 5 + 4;
 
 /// Several quadrature fields projected in one pass over the gather table
 /// ([`Model::project`] of a fixed-size row): each entry gets the same
@@ -474,16 +471,23 @@ pub fn particle_piece(model: &Model, fields: &[String]) -> VtuPiece {
         let v = model.physical(&p.v);
         piece = piece.with_point_data(DataArray::vectors("velocity", &v.iter().map(v3).collect::<Vec<_>>()));
     }
+    // The scalars' slots follow the stress's five in each projected row.
+    let scalar_fields: [(&str, &[Real]); PROJECTED - 5] = [
+        ("plastic_strain", &q.eps_p),
+        ("plastic_strain_rate", &q.eps_p_rate),
+        ("temperature", &q.temperature),
+        ("damage", &q.damage),
+    ];
     let stress_wanted = want("stress") || want("effective_stress") || want("pressure");
-    if stress_wanted || SCALAR_FIELDS.iter().any(|f| want(f)) {
-        let columns: [&[Real]; 4] = [&q.eps_p, &q.eps_p_rate, &q.temperature, &q.damage];
+    if stress_wanted || scalar_fields.iter().any(|(f, _)| want(f)) {
         // Per point: Cauchy `τ/J` entry by entry (as `Tensor3 / J`), then the scalars.
         let values: Vec<Row<PROJECTED>> = (0..q.len())
             .into_par_iter()
             .map(|k| {
                 let (t, j) = (&q.tau[k], q.f[k].determinant());
-                let mut row = [t.xx / j, t.xy / j, t.yx / j, t.yy / j, t.zz / j, 0.0, 0.0, 0.0, 0.0];
-                for (slot, col) in row[5..].iter_mut().zip(columns) {
+                let mut row = [0.0; PROJECTED];
+                row[..5].copy_from_slice(&[t.xx / j, t.xy / j, t.yx / j, t.yy / j, t.zz / j]);
+                for (slot, (_, col)) in row[5..].iter_mut().zip(&scalar_fields) {
                     *slot = col[k];
                 }
                 Row(row)
@@ -509,7 +513,7 @@ pub fn particle_piece(model: &Model, fields: &[String]) -> VtuPiece {
                     piece.with_point_data(DataArray::scalars("pressure", s.iter().map(|t| -mean_stress(t)).collect()));
             }
         }
-        for (c, name) in SCALAR_FIELDS.iter().enumerate() {
+        for (c, (name, _)) in scalar_fields.iter().enumerate() {
             if want(name) {
                 piece =
                     piece.with_point_data(DataArray::scalars(*name, projected.iter().map(|r| r.0[5 + c]).collect()));
