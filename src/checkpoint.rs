@@ -70,13 +70,13 @@
 
 use crate::case::{Case, MaterialSpec};
 use crate::contact::{ContactAccumulators, ContactSystem, MasterFeature, Pairing, SlaveSet};
-use crate::fracture::rows::Basis;
 use crate::fracture::{Crack, CrackEvent, CrackGrowth, CrackVertex, Criterion, EventKind, FractureParameters};
 use crate::material::Material;
 use crate::math::{Block2, Real, Tensor3, Vec2};
 use crate::model::{BodyInfo, Gather, Model};
 use crate::particles::{FaceSide, ParticleFlags, Particles};
 use crate::quadrature::{QuadraturePoints, NO_CARRY};
+use crate::shape::Basis;
 use crate::shape::ShapeTable;
 use crate::step::{Energies, Simulation, TimeStepRule};
 use std::fs::File;

@@ -14,6 +14,18 @@ use crate::step::Simulation;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
+/// Why a plot of a run's results could not be made: its history could not
+/// be read, or the image could not be drawn. Its own type, so that `output`
+/// needs nothing of `run`, which drives it ([`crate::run::RunError::Output`]
+/// wraps it).
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    #[error(transparent)]
+    Io(#[from] IoError),
+    #[error(transparent)]
+    Plot(#[from] crate::io::PlotError),
+}
+
 /// Columns of the history CSV that every run has, in order: time, step,
 /// energies, and the plug once cracks have cut one out under the first
 /// rigid body (`plug_mass`, kg or kg/m in plane strain, and its
@@ -534,7 +546,7 @@ pub fn particle_piece(model: &Model, fields: &[String]) -> VtuPiece {
 
 /// Plot the energy history of the run in `dir` (`energy.png`) from its
 /// `history.csv`; returns the files written.
-pub fn plot_history(dir: &Path) -> Result<Vec<PathBuf>, crate::run::RunError> {
+pub fn plot_history(dir: &Path) -> Result<Vec<PathBuf>, OutputError> {
     let table = crate::io::HistoryTable::read(&dir.join("history.csv"))?;
     let t: Vec<Real> = table.column("time").unwrap_or_default().iter().map(|t| t * 1e6).collect();
     let series = |col: &str, label: &str| crate::io::Series {
@@ -636,7 +648,7 @@ fn shear_band_window(sim: &Simulation) -> Option<[Real; 4]> {
 /// End-of-run field plots (`effective_stress.png`, `temperature.png`) of the
 /// region around the first rigid body (±1.5 projectile widths), or of
 /// everything without one.
-pub fn plot_fields(sim: &Simulation, dir: &Path) -> Result<Vec<PathBuf>, crate::run::RunError> {
+pub fn plot_fields(sim: &Simulation, dir: &Path) -> Result<Vec<PathBuf>, OutputError> {
     let window = impact_window(sim);
     let mut written = Vec::new();
     for field in ["effective_stress", "temperature"] {
@@ -665,7 +677,7 @@ pub fn time_label(t: Real) -> String {
 /// cracks (`effective_stress_<at>.png`), and the temperature of the shear
 /// band at the projectile's corner (`temperature_<at>.png`, see
 /// [`time_label`]); both fields over everything without a rigid body.
-pub fn plot_fields_at(sim: &Simulation, dir: &Path, at: Real) -> Result<Vec<PathBuf>, crate::run::RunError> {
+pub fn plot_fields_at(sim: &Simulation, dir: &Path, at: Real) -> Result<Vec<PathBuf>, OutputError> {
     let label = time_label(at);
     let mut written = Vec::new();
     for (field, window) in [("effective_stress", impact_window(sim)), ("temperature", shear_band_window(sim))] {

@@ -125,6 +125,8 @@ pub enum RunError {
     Io(#[from] IoError),
     #[error(transparent)]
     Plot(#[from] crate::io::PlotError),
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
     #[error("{error}\n  the state at failure is in {}; all earlier output is kept in {}", last_snapshot.display(), dir.display())]
     Unstable { error: SolverError, last_snapshot: PathBuf, dir: PathBuf },
     #[error(transparent)]

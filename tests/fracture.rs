@@ -9,13 +9,13 @@ mod common;
 use plugsim::case::Case;
 use plugsim::contact::{SlaveSet, SurfaceDetection};
 use plugsim::fracture::growth::nodal_mass;
-use plugsim::fracture::rows::Basis;
 use plugsim::fracture::{CrackGrowth, Criterion, EventKind, FractureParameters};
 use plugsim::geometry::GeometryMode;
 use plugsim::material::{Elastic, Material};
 use plugsim::math::{Block2, Real, Vec2};
 use plugsim::model::{BodySetup, Gather, Model};
 use plugsim::particles::ParticleFlags;
+use plugsim::shape::Basis;
 use plugsim::shape::ShapeTable;
 use plugsim::step::{Simulation, TimeStepRule};
 

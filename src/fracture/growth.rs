@@ -6,7 +6,6 @@
 use super::geometry::{
     left_bisector, left_normal, point_segment_distance, sector_angles, sector_contains, widest_empty_sector,
 };
-use super::rows::{rebuild_rows_with_fallback, Basis};
 use super::visibility::{CrackSegments, CrackVisibility};
 use super::{Criterion, FractureError, FractureParameters};
 use crate::geometry::GeometryMode;
@@ -16,6 +15,7 @@ use crate::model::{Gather, Model};
 use crate::neighbors::CellGrid;
 use crate::particles::{FaceSide, ParticleFlags};
 use crate::shape::ShapeTable;
+use crate::shape::{rebuild_rows, Basis};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 
@@ -822,26 +822,9 @@ impl CrackGrowth {
         let mut particle_shape = std::mem::take(&mut model.particle_shape);
         let spare = &mut self.spare;
         let (qx, px) = (&model.quad.x0, &p.x0);
-        let r1 = rebuild_rows_with_fallback(
-            &mut qp_shape,
-            &mut spare.qp_shape,
-            &rows_q,
-            qx,
-            px,
-            &p.support,
-            &p.volume,
-            &vis,
-        );
-        let r2 = rebuild_rows_with_fallback(
-            &mut particle_shape,
-            &mut spare.particle_shape,
-            &rows_p,
-            px,
-            px,
-            &p.support,
-            &p.volume,
-            &vis,
-        );
+        let r1 = rebuild_rows(&mut qp_shape, &mut spare.qp_shape, &rows_q, qx, px, &p.support, &p.volume, &vis);
+        let r2 =
+            rebuild_rows(&mut particle_shape, &mut spare.particle_shape, &rows_p, px, px, &p.support, &p.volume, &vis);
         model.qp_shape = qp_shape;
         model.particle_shape = particle_shape;
         for (rows, reduced, map) in

@@ -8,8 +8,10 @@
 //! - [`growth`]: [`CrackGrowth`], the crack-growth stage: criteria,
 //!   nucleation, propagation, arrest, splitting, the local rebuild of the
 //!   shape tables and lumped masses, and the crack event log.
-//! - [`rows`]: the local row rebuild, with a reduced basis where a crack
-//!   leaves too few visible particles (an acute wedge at a free surface).
+//! - The local row rebuild, with a reduced basis where a crack leaves too
+//!   few visible particles (an acute wedge at a free surface), is the shape
+//!   module's one row builder ([`crate::shape::rebuild_rows`],
+//!   [`crate::shape::Basis`]).
 //!
 //! Everything is in the **reference configuration** (total Lagrangian):
 //! crack paths, the fan and circle tests, split offsets and visibility.
@@ -183,7 +185,6 @@
 
 pub mod geometry;
 pub mod growth;
-pub mod rows;
 pub mod visibility;
 
 pub use growth::{Crack, CrackEvent, CrackGrowth, CrackVertex, EventKind};

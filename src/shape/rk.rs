@@ -1,11 +1,12 @@
-//! Construction of RK shape functions with a bilinear basis (SPEC §3,
-//! [RL10, Eqs. (2.37)–(2.45)]).
+//! Construction of RK shape functions (SPEC §3, [RL10, Eqs. (2.37)–(2.45)]):
+//! one row builder for the method's bilinear basis and the reduced bases
+//! a crack may call for, a whole-table build and a local rebuild.
 
 use super::ShapeTable;
 use crate::kernel::window_cubic_spline_2d;
 use crate::math::{Real, Vec2};
 use crate::neighbors::SupportSearch;
-use nalgebra::{Matrix4, Vector4};
+use nalgebra::{SMatrix, SVector};
 use rayon::prelude::*;
 
 /// Decides whether particle `i` may contribute to the RK sum at point `x`
@@ -44,69 +45,91 @@ pub enum ShapeError {
 pub const MAX_MOMENT_CONDITION: Real = 1e10;
 
 /// One row of a table: `(particle, N, ∇N)` entries.
-type Row = Vec<(u32, Real, Vec2)>;
+pub type Row = Vec<(u32, Real, Vec2)>;
 
-/// Scratch for one row, reused across points of a thread.
-#[derive(Default)]
-struct RowScratch {
-    cand: Vec<u32>,
+/// The polynomial basis of a row, `p(Z)` in `N_I = pᵀ(0) M⁻¹ p(Z_I) φ_I ΔV_I`.
+///
+/// The method's basis is bilinear ([RL10, Eq. (2.39)]). Next to a crack an
+/// evaluation point may see too few or nearly collinear particles for it
+/// (a wedge between a crack and a free surface): such a row falls back to
+/// the linear basis, still exactly linear-reproducing, and then to the
+/// constant one (Shepard functions: partition of unity only)
+/// ([`row_with_fallback`]; SPEC §9, a deviation the fracture module
+/// documents).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Basis {
+    /// `[1, Z_x, Z_y, Z_x Z_y]`, the method's basis ([RL10, Eq. (2.39)]).
+    Bilinear,
+    /// `[1, Z_x, Z_y]`: linear reproduction.
+    Linear,
+    /// `[1]`: partition of unity only.
+    Constant,
 }
 
-/// Compute the shape-function row at point `x` into `(index, value, grad)`.
+/// Basis `p` at scaled `z = Z / L` and its derivatives with respect to X
+/// (`inv_l = 1/L`): the first `M` terms of `[1, z_x, z_y, z_x z_y]`, so
+/// `M = 4, 3, 1` are the bilinear, linear and constant bases.
+#[inline(always)]
+fn basis_terms<const M: usize>(z: &Vec2, inv_l: Real) -> (SVector<Real, M>, [SVector<Real, M>; 2]) {
+    let all = [1.0, z.x, z.y, z.x * z.y];
+    let dx = [0.0, inv_l, 0.0, z.y * inv_l];
+    let dy = [0.0, 0.0, inv_l, z.x * inv_l];
+    (SVector::from_fn(|i, _| all[i]), [SVector::from_fn(|i, _| dx[i]), SVector::from_fn(|i, _| dy[i])])
+}
+
+/// The row at `x` of the visible covering particles `cand` with the first
+/// `M` basis terms ([`basis_terms`]), appended to `out` (cleared first).
 ///
 /// With `Z = X − X_I`, the basis is scaled by a length `L` (the mean support
 /// of the covering particles) for conditioning: `p(Z) = [1, Z_x/L, Z_y/L,
 /// Z_x Z_y/L²]`, which spans the same space, so `N_I` is unchanged:
 /// `N_I = pᵀ(0) M⁻¹ p(Z_I) φ_I ΔV_I`, `M = Σ p pᵀ φ ΔV`. Gradients follow
-/// from `∂M⁻¹ = −M⁻¹ ∂M M⁻¹` exactly (SPEC §3).
-#[allow(non_snake_case, clippy::too_many_arguments)]
-fn row_at(
-    point: usize,
+/// from `∂M⁻¹ = −M⁻¹ ∂M M⁻¹` exactly (SPEC §3, [RL10, Eqs. (2.37)–(2.45)]).
+/// Fixed-size matrices for every basis: the bilinear instance is the fast
+/// path of every table build. `Err(condition)` if the moment matrix is
+/// singular or worse conditioned than [`MAX_MOMENT_CONDITION`].
+/// `eigenvalues` is nalgebra's symmetric eigenvalue solver at the caller's
+/// concrete size (its trait bounds do not name a generic size).
+#[allow(non_snake_case)]
+fn row_of_size<const M: usize>(
     x: &Vec2,
+    cand: &[u32],
     x0: &[Vec2],
     support: &[Real],
     volume: &[Real],
-    search: &SupportSearch,
-    vis: &dyn Visibility,
-    scratch: &mut RowScratch,
+    eigenvalues: impl Fn(SMatrix<Real, M, M>) -> SVector<Real, M>,
     out: &mut Row,
-) -> Result<(), ShapeError> {
-    // Legend: Z = X - X_I; p = scaled basis; phi = window; M = moment matrix.
+) -> Result<(), Real> {
+    // Legend: Z = X - X_I; p = scaled basis; phi = window x volume; M = moment matrix.
     out.clear();
-    search.covering(x, &mut scratch.cand);
-    scratch.cand.retain(|&i| vis.visible(x, i as usize));
-    let n = scratch.cand.len();
-    let L = if n > 0 { scratch.cand.iter().map(|&i| support[i as usize]).sum::<Real>() / n as Real } else { 1.0 };
+    if cand.len() < M {
+        return Err(Real::INFINITY);
+    }
+    let L = cand.iter().map(|&i| support[i as usize]).sum::<Real>() / cand.len() as Real;
     let inv_l = 1.0 / L;
-    let mut M = Matrix4::<Real>::zeros();
-    let mut dM = [Matrix4::<Real>::zeros(); 2];
-    for &i in &scratch.cand {
+    let mut Mm = SMatrix::<Real, M, M>::zeros();
+    let mut dM = [SMatrix::<Real, M, M>::zeros(); 2];
+    for &i in cand {
         let i = i as usize;
         let Z = x - x0[i];
         let (phi, dphi) = window_cubic_spline_2d(&Z, support[i]);
         let (phi, dphi) = (phi * volume[i], dphi * volume[i]);
-        let z = Z * inv_l;
-        let p = Vector4::new(1.0, z.x, z.y, z.x * z.y);
-        let dp = [Vector4::new(0.0, inv_l, 0.0, z.y * inv_l), Vector4::new(0.0, 0.0, inv_l, z.x * inv_l)];
+        let (p, dp) = basis_terms::<M>(&(Z * inv_l), inv_l);
         let ppt = p * p.transpose();
-        M += ppt * phi;
+        Mm += ppt * phi;
         for k in 0..2 {
             dM[k] += (dp[k] * p.transpose() + p * dp[k].transpose()) * phi + ppt * dphi[k];
         }
     }
-    let singular = |condition: Real| ShapeError::SingularMoment { point, x: x.x, y: x.y, neighbours: n, condition };
-    if n < 4 {
-        return Err(singular(Real::INFINITY));
-    }
-    let eig = M.symmetric_eigenvalues();
+    let eig = eigenvalues(Mm);
     let (lo, hi) = (eig.min(), eig.max());
     if lo <= 0.0 || !(hi / lo).is_finite() || hi / lo > MAX_MOMENT_CONDITION {
-        return Err(singular(if lo > 0.0 { hi / lo } else { Real::INFINITY }));
+        return Err(if lo > 0.0 { hi / lo } else { Real::INFINITY });
     }
-    let chol = M.cholesky().ok_or_else(|| singular(Real::INFINITY))?;
-    let b = chol.solve(&Vector4::new(1.0, 0.0, 0.0, 0.0));
+    let chol = Mm.cholesky().ok_or(Real::INFINITY)?;
+    let b = chol.solve(&SVector::<Real, M>::from_fn(|i, _| if i == 0 { 1.0 } else { 0.0 }));
     let db = [-chol.solve(&(dM[0] * b)), -chol.solve(&(dM[1] * b))];
-    for &i in &scratch.cand {
+    for &i in cand {
         let iu = i as usize;
         let Z = x - x0[iu];
         let (phi, dphi) = window_cubic_spline_2d(&Z, support[iu]);
@@ -114,23 +137,96 @@ fn row_at(
             continue;
         }
         let (phi, dphi) = (phi * volume[iu], dphi * volume[iu]);
-        let z = Z * inv_l;
-        let p = Vector4::new(1.0, z.x, z.y, z.x * z.y);
-        let dp = [Vector4::new(0.0, inv_l, 0.0, z.y * inv_l), Vector4::new(0.0, 0.0, inv_l, z.x * inv_l)];
+        let (p, dp) = basis_terms::<M>(&(Z * inv_l), inv_l);
         let bp = b.dot(&p);
-        let value = bp * phi;
         let mut grad = Vec2::zeros();
         for k in 0..2 {
             grad[k] = (db[k].dot(&p) + b.dot(&dp[k])) * phi + bp * dphi[k];
         }
-        out.push((i, value, grad));
+        out.push((i, bp * phi, grad));
     }
     Ok(())
 }
 
+/// The row at `x` from the visible covering particles `cand` with `basis`
+/// ([`row_of_size`]); `Err(condition number)` if its moment matrix is
+/// singular.
+pub fn row_with_basis(
+    x: &Vec2,
+    cand: &[u32],
+    x0: &[Vec2],
+    support: &[Real],
+    volume: &[Real],
+    basis: Basis,
+    out: &mut Row,
+) -> Result<(), Real> {
+    match basis {
+        Basis::Bilinear => row_of_size::<4>(x, cand, x0, support, volume, |m| m.symmetric_eigenvalues(), out),
+        Basis::Linear => row_of_size::<3>(x, cand, x0, support, volume, |m| m.symmetric_eigenvalues(), out),
+        Basis::Constant => row_of_size::<1>(x, cand, x0, support, volume, |m| m.symmetric_eigenvalues(), out),
+    }
+}
+
+/// The particles whose windows cover `x` and that `vis` lets through, into
+/// `cand`.
+fn visible_covering(x: &Vec2, search: &SupportSearch, vis: &dyn Visibility, cand: &mut Vec<u32>) {
+    search.covering(x, cand);
+    cand.retain(|&i| vis.visible(x, i as usize));
+}
+
+/// The bilinear row at evaluation point number `point` (for the error),
+/// the method's row everywhere a crack leaves enough particles.
+#[allow(clippy::too_many_arguments)]
+fn bilinear_row(
+    point: usize,
+    x: &Vec2,
+    x0: &[Vec2],
+    support: &[Real],
+    volume: &[Real],
+    search: &SupportSearch,
+    vis: &dyn Visibility,
+    cand: &mut Vec<u32>,
+    out: &mut Row,
+) -> Result<(), ShapeError> {
+    visible_covering(x, search, vis, cand);
+    row_with_basis(x, cand, x0, support, volume, Basis::Bilinear, out).map_err(|condition| ShapeError::SingularMoment {
+        point,
+        x: x.x,
+        y: x.y,
+        neighbours: cand.len(),
+        condition,
+    })
+}
+
+/// The row at `x` (evaluation point number `point`, for the error) with the
+/// richest basis whose moment matrix is regular ([`Basis`]); an error only
+/// if no particle is visible at all.
+#[allow(clippy::too_many_arguments)]
+pub fn row_with_fallback(
+    point: usize,
+    x: &Vec2,
+    search: &SupportSearch,
+    x0: &[Vec2],
+    support: &[Real],
+    volume: &[Real],
+    vis: &dyn Visibility,
+    cand: &mut Vec<u32>,
+) -> Result<(Row, Basis), ShapeError> {
+    visible_covering(x, search, vis, cand);
+    let mut row = Row::new();
+    for basis in [Basis::Bilinear, Basis::Linear, Basis::Constant] {
+        if row_with_basis(x, cand, x0, support, volume, basis, &mut row).is_ok() {
+            return Ok((row, basis));
+        }
+    }
+    Err(ShapeError::SingularMoment { point, x: x.x, y: x.y, neighbours: cand.len(), condition: Real::INFINITY })
+}
+
 /// Build the shape-function table at `points` for particles with reference
-/// positions `x0`, supports `support` and volumes `volume`, honouring `vis`.
-/// Rows are computed in parallel; the result does not depend on thread count.
+/// positions `x0`, supports `support` and volumes `volume`, honouring `vis`,
+/// with the method's bilinear basis everywhere (an error where it is
+/// singular). Rows are computed in parallel; the result does not depend on
+/// thread count.
 pub fn build_table(
     points: &[Vec2],
     x0: &[Vec2],
@@ -142,45 +238,77 @@ pub fn build_table(
     let rows: Vec<Row> = points
         .par_iter()
         .enumerate()
-        .map_init(RowScratch::default, |scratch, (p, x)| {
+        .map_init(Vec::new, |cand, (p, x)| {
             let mut out = Vec::new();
-            row_at(p, x, x0, support, volume, &search, vis, scratch, &mut out).map(|_| out)
+            bilinear_row(p, x, x0, support, volume, &search, vis, cand, &mut out).map(|_| out)
         })
         .collect::<Result<_, _>>()?;
     Ok(assemble(rows))
 }
 
-/// Recompute only the rows `which` of `table` (after a local visibility
-/// change); all other rows are kept as they are.
+/// Recompute rows `which` (ascending, unique) of `table` at `points` after a
+/// local visibility change, each with the richest regular basis
+/// ([`row_with_fallback`]), keeping every other row; returns the rows that
+/// needed a reduced basis, with that basis. The new table is written into
+/// `spare` (its allocations reused) and swapped with `table`: `spare` then
+/// holds the table as it was. On an error `table` is unchanged. A rebuilt
+/// row whose visibility did not change equals the row [`build_table`] made,
+/// bit for bit (same builder).
+#[allow(clippy::too_many_arguments)]
 pub fn rebuild_rows(
     table: &mut ShapeTable,
+    spare: &mut ShapeTable,
     which: &[usize],
     points: &[Vec2],
     x0: &[Vec2],
     support: &[Real],
     volume: &[Real],
     vis: &dyn Visibility,
-) -> Result<(), ShapeError> {
+) -> Result<Vec<(usize, Basis)>, ShapeError> {
     let search = SupportSearch::new(x0, support);
-    let fresh: Vec<(usize, Row)> = which
+    // Rows are independent: built in parallel, collected in `which` order.
+    let built: Vec<(Row, Basis)> = which
         .par_iter()
-        .map_init(RowScratch::default, |scratch, &p| {
-            let mut out = Vec::new();
-            row_at(p, &points[p], x0, support, volume, &search, vis, scratch, &mut out).map(|_| (p, out))
-        })
+        .map_init(Vec::new, |cand, &r| row_with_fallback(r, &points[r], &search, x0, support, volume, vis, cand))
         .collect::<Result<_, _>>()?;
-    let mut replaced: Vec<Option<Row>> = vec![None; table.rows()];
-    for (p, row) in fresh {
-        replaced[p] = Some(row);
+    let reduced: Vec<(usize, Basis)> =
+        which.iter().zip(&built).filter(|(_, (_, b))| *b != Basis::Bilinear).map(|(&r, &(_, b))| (r, b)).collect();
+    // Sized up front: growing the columns entry by entry reallocated and
+    // copied the whole table a few times per split.
+    let nnz = table.nnz() - which.iter().map(|&r| table.range(r).len()).sum::<usize>()
+        + built.iter().map(|(row, _)| row.len()).sum::<usize>();
+    let out = spare;
+    out.offsets.clear();
+    out.index.clear();
+    out.value.clear();
+    out.grad.clear();
+    out.offsets.reserve(table.offsets.len());
+    out.index.reserve(nnz);
+    out.value.reserve(nnz);
+    out.grad.reserve(nnz);
+    out.offsets.push(0);
+    let mut next = which.iter().zip(built.into_iter().map(|(row, _)| row)).peekable();
+    for r in 0..table.rows() {
+        match next.peek() {
+            Some((&w, _)) if w == r => {
+                let (_, row) = next.next().expect("peeked");
+                for (i, v, g) in row {
+                    out.index.push(i);
+                    out.value.push(v);
+                    out.grad.push(g);
+                }
+            }
+            _ => {
+                let range = table.range(r);
+                out.index.extend_from_slice(&table.index[range.clone()]);
+                out.value.extend_from_slice(&table.value[range.clone()]);
+                out.grad.extend_from_slice(&table.grad[range]);
+            }
+        }
+        out.offsets.push(out.index.len());
     }
-    let rows: Vec<Row> = (0..table.rows())
-        .map(|p| match replaced[p].take() {
-            Some(r) => r,
-            None => table.range(p).map(|k| (table.index[k], table.value[k], table.grad[k])).collect(),
-        })
-        .collect();
-    *table = assemble(rows);
-    Ok(())
+    std::mem::swap(table, out);
+    Ok(reduced)
 }
 
 fn assemble(rows: Vec<Row>) -> ShapeTable {
@@ -201,4 +329,80 @@ fn assemble(rows: Vec<Row>) -> ShapeTable {
         t.offsets.push(t.index.len());
     }
     t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lattice(n: usize, h: Real) -> (Vec<Vec2>, Vec<Real>, Vec<Real>) {
+        let x0: Vec<Vec2> = (0..n * n).map(|k| Vec2::new((k % n) as Real * h, (k / n) as Real * h)).collect();
+        (x0, vec![2.0 * h; n * n], vec![h * h; n * n])
+    }
+
+    /// Without a crack, a rebuilt row is the row of the whole-table build,
+    /// bit for bit (one builder); the linear and constant bases keep their
+    /// reproduction properties (partition of unity, and for the linear basis
+    /// `Σ N_I X_I = X`, with gradients summing to zero); three collinear
+    /// particles make the bilinear and linear moment matrices singular but
+    /// not the constant one.
+    #[test]
+    fn reduced_basis_rows_stay_consistent() {
+        let h = 1e-3;
+        let (x0, a, v) = lattice(8, h);
+        let pts = vec![Vec2::new(3.3 * h, 2.7 * h), Vec2::new(0.1 * h, 0.2 * h)];
+        let reference = build_table(&pts, &x0, &a, &v, &AllVisible).unwrap();
+        let mut t = reference.clone();
+        let reduced =
+            rebuild_rows(&mut t, &mut ShapeTable::default(), &[0, 1], &pts, &x0, &a, &v, &AllVisible).unwrap();
+        assert!(reduced.is_empty());
+        assert_eq!(t, reference);
+        let search = SupportSearch::new(&x0, &a);
+        let mut cand = Vec::new();
+        search.covering(&pts[0], &mut cand);
+        let mut row = Row::new();
+        for basis in [Basis::Linear, Basis::Constant] {
+            row_with_basis(&pts[0], &cand, &x0, &a, &v, basis, &mut row).unwrap();
+            let s: Real = row.iter().map(|r| r.1).sum();
+            let g: Vec2 = row.iter().map(|r| r.2).sum();
+            assert!((s - 1.0).abs() < 1e-12 && g.norm() < 1e-8 / h, "{basis:?}: sum {s}, gradient sum {g}");
+            if basis == Basis::Linear {
+                let sx: Vec2 = row.iter().map(|r| x0[r.0 as usize] * r.1).sum();
+                assert!((sx - pts[0]).norm() < 1e-12 * h);
+            }
+        }
+        let line: Vec<u32> = vec![0, 1, 2];
+        for (basis, regular) in [(Basis::Bilinear, false), (Basis::Linear, false), (Basis::Constant, true)] {
+            assert_eq!(row_with_basis(&pts[1], &line, &x0, &a, &v, basis, &mut row).is_ok(), regular, "{basis:?}");
+        }
+    }
+
+    /// The gradients of every basis are the derivatives of the values: a
+    /// central finite difference of each `N_I` at a point matches `∇N_I`.
+    #[test]
+    fn gradients_are_derivatives_for_every_basis() {
+        let h = 1e-3;
+        let (x0, a, v) = lattice(8, h);
+        let search = SupportSearch::new(&x0, &a);
+        let x = Vec2::new(3.3 * h, 2.7 * h);
+        let d = 1e-7 * h;
+        for basis in [Basis::Bilinear, Basis::Linear, Basis::Constant] {
+            let row_at = |x: &Vec2| {
+                let (mut cand, mut row) = (Vec::new(), Row::new());
+                search.covering(x, &mut cand);
+                row_with_basis(x, &cand, &x0, &a, &v, basis, &mut row).unwrap();
+                row
+            };
+            let centre = row_at(&x);
+            for k in 0..2 {
+                let e = if k == 0 { Vec2::new(d, 0.0) } else { Vec2::new(0.0, d) };
+                let (plus, minus) = (row_at(&(x + e)), row_at(&(x - e)));
+                for (c, (p, m)) in centre.iter().zip(plus.iter().zip(&minus)) {
+                    assert!(c.0 == p.0 && c.0 == m.0, "same particles at the shifted points");
+                    let fd = (p.1 - m.1) / (2.0 * d);
+                    assert!((fd - c.2[k]).abs() < 1e-5 / h, "{basis:?}: particle {}, d/dX{k}: {fd} vs {}", c.0, c.2[k]);
+                }
+            }
+        }
+    }
 }
