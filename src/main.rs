@@ -493,6 +493,12 @@ fn check(case: &Case, file: &str) -> Result<()> {
         plugsim::memory::human_bytes(available as f64),
         plugsim::memory::human_bytes(footprint.checkpoint_bytes())
     );
+    let entries: usize = sim.model.qp_shape.nnz() + sim.model.particle_shape.nnz();
+    println!(
+        "  shape entries   {entries} (estimated {:.0}); built with a peak resident memory of {}",
+        footprint.quadrature_entries + footprint.particle_entries,
+        plugsim::memory::peak_resident().map_or("(unknown)".into(), |b| plugsim::memory::human_bytes(b as f64))
+    );
     println!("  mass            {:.6e} kg", sim.model.particles.total_mass());
     println!("  built in        {:.2} s", t.elapsed().as_secs_f64());
     Ok(())
@@ -589,6 +595,13 @@ fn drive(
     );
     for (name, d) in &s.stage_timers {
         println!("    {name:30} {:8.3} s", d.as_secs_f64());
+    }
+    if let Some(peak) = s.peak_resident {
+        println!(
+            "  memory: peak resident {} (estimated {})",
+            plugsim::memory::human_bytes(peak as f64),
+            plugsim::memory::human_bytes(s.memory_estimate)
+        );
     }
     let qp_rate = s.quadrature_points as f64 * s.steps as f64 / s.loop_wall.as_secs_f64().max(1e-9);
     println!(

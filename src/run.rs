@@ -85,6 +85,13 @@ pub struct RunSummary {
     pub energies: crate::step::Energies,
     /// Largest |energy drift| seen at a history row.
     pub max_drift: Real,
+    /// Estimated peak memory of the case, bytes
+    /// ([`crate::memory::Footprint::bytes`]).
+    pub memory_estimate: Real,
+    /// Peak resident memory of the process at the end of the run, bytes
+    /// ([`crate::memory::peak_resident`]; the whole process, so a second run
+    /// in the same process reports the larger of the two).
+    pub peak_resident: Option<u64>,
     pub out_dir: PathBuf,
     /// PNG plots written at the end.
     pub plots: Vec<PathBuf>,
@@ -510,6 +517,8 @@ fn time_loop(
         stage_timers: sim.timers.list(),
         energies: sim.energies,
         max_drift: schedule.max_drift,
+        memory_estimate: preflight(case)?.bytes(),
+        peak_resident: crate::memory::peak_resident(),
         out_dir: cfg.out_dir.clone(),
     })
 }
