@@ -24,7 +24,7 @@ use rayon::prelude::*;
 pub type Row = Vec<(u32, Real, Vec2)>;
 
 /// The polynomial basis of a row.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
 pub enum Basis {
     /// `[1, Z_x, Z_y, Z_x Z_y]`, the method's basis ([RL10, Eq. (2.39)]).
     Bilinear,
