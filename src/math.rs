@@ -155,7 +155,7 @@ pub fn mul_2d(a: &Tensor3, b: &Tensor3) -> Tensor3 {
 /// them for block-form operands and the non-negative scale factors used; the ones left out of sums (`ddot`, `von
 /// Mises`) are `±0` terms, which never change a running sum that starts at
 /// `+0` (such a sum is never `−0`).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Block2 {
     pub xx: Real,
     pub xy: Real,
@@ -171,7 +171,7 @@ pub struct Block2 {
 /// three offsets in eight). The force gather reads `P w` this way
 /// ([`crate::quadrature::QuadraturePoints::pw`]); measured on the fine
 /// Case I's gather, one thread, 1.2–1.4× faster than from `Block2`s.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 #[repr(C, align(32))]
 pub struct InPlane {
     pub xx: Real,

@@ -74,7 +74,7 @@ pub struct BodySetup {
 }
 
 /// Per-body bookkeeping.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct BodyInfo {
     pub name: String,
     /// Particle index range in the store.
@@ -89,7 +89,7 @@ pub struct BodyInfo {
 /// entries (and their rows) that involve it, in ascending entry order. The
 /// internal force is a gather over this list, so no two threads ever write
 /// the same particle and sums are bit-identical for any thread count.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Gather {
     /// Per-particle starts into `entry`, length `particles + 1`.
     pub offsets: Vec<usize>,
@@ -98,13 +98,23 @@ pub struct Gather {
     /// Quadrature point (row) of that entry.
     pub point: Vec<u32>,
     /// `N_I(X_q)` of that entry, copied in gather order so the force sweep
-    /// streams through memory.
+    /// streams through memory. Not in checkpoints (nor `grad`): copies of
+    /// the table's entries, refilled on reading ([`Gather::copy_entries`]).
+    #[serde(skip)]
     pub value: Vec<Real>,
     /// `∇N_I(X_q)` of that entry, in gather order.
+    #[serde(skip)]
     pub grad: Vec<Vec2>,
 }
 
 impl Gather {
+    /// Fill `value` and `grad` with the entries of `table` that `entry`
+    /// names (every entry must be in range), in gather order.
+    pub fn copy_entries(&mut self, table: &ShapeTable) {
+        self.value = self.entry.iter().map(|&k| table.value[k as usize]).collect();
+        self.grad = self.entry.iter().map(|&k| table.grad[k as usize]).collect();
+    }
+
     /// Build from a table whose column indices are particles `0..n`.
     ///
     /// In parallel over blocks of particles (`Gather::fill`): each block
@@ -316,12 +326,14 @@ impl GatherBlock<'_> {
 }
 
 /// Everything the time loop works on.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Model {
     pub mode: GeometryMode,
     pub particles: Particles,
     pub quad: QuadraturePoints,
-    /// Material of each body (indexed by body number).
+    /// Material of each body (indexed by body number). Not in checkpoints:
+    /// rebuilt from the case stored beside the state.
+    #[serde(skip)]
     pub materials: Vec<Material>,
     pub bodies: Vec<BodyInfo>,
     /// `N_I(X_q)`, `∇N_I(X_q)` at the quadrature points.

@@ -8,7 +8,7 @@
 use crate::math::{Real, Vec2};
 
 /// Bit flags describing a particle's role.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub struct ParticleFlags(pub u8);
 
 impl ParticleFlags {
@@ -53,7 +53,7 @@ impl ParticleFlags {
 /// Within `reach` of the vertex (the length of the shorter adjacent crack
 /// segment) the particle is visible only from its own side; farther away
 /// the crack segments themselves decide (see `fracture::visibility`).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct FaceSide {
     /// Reference position of the crack vertex, m.
     pub vertex: Vec2,
@@ -68,7 +68,7 @@ pub struct FaceSide {
 }
 
 /// All particles of all deformable bodies.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Particles {
     /// Reference position `X_I`, m.
     pub x0: Vec<Vec2>,
@@ -108,6 +108,46 @@ impl Particles {
     }
     pub fn is_empty(&self) -> bool {
         self.x0.is_empty()
+    }
+
+    /// Whether every column has one entry per particle (a check of a store
+    /// read from a checkpoint; a column added to the store fails to compile
+    /// here until it is listed).
+    pub fn columns_agree(&self) -> bool {
+        let Particles {
+            x0,
+            u,
+            v,
+            a,
+            f_int,
+            f_ext,
+            mass,
+            volume,
+            spacing,
+            support,
+            temperature,
+            body,
+            flags,
+            face_side,
+        } = self;
+        let n = x0.len();
+        [
+            u.len(),
+            v.len(),
+            a.len(),
+            f_int.len(),
+            f_ext.len(),
+            mass.len(),
+            volume.len(),
+            spacing.len(),
+            support.len(),
+            temperature.len(),
+            body.len(),
+            flags.len(),
+            face_side.len(),
+        ]
+        .iter()
+        .all(|&l| l == n)
     }
 
     /// Append one particle at rest.

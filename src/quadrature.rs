@@ -5,7 +5,7 @@ use crate::material::PointState;
 use crate::math::{Block2, InPlane, Real, Tensor3, Vec2};
 
 /// All quadrature points of all bodies. Index `q` in `0..len()`.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct QuadraturePoints {
     /// Reference position `X_q`, m.
     pub x0: Vec<Vec2>,
@@ -61,6 +61,34 @@ impl QuadraturePoints {
     }
     pub fn is_empty(&self) -> bool {
         self.x0.is_empty()
+    }
+
+    /// Whether every per-point column has one entry per point and every
+    /// carried jump named exists (a check of a store read from a
+    /// checkpoint; a column added to the store fails to compile here until
+    /// it is listed).
+    pub fn columns_agree(&self) -> bool {
+        let QuadraturePoints {
+            x0,
+            weight,
+            body,
+            eroded,
+            f_carry_slot,
+            f_carry,
+            f,
+            tau,
+            pw,
+            pw_zz,
+            eps_p,
+            eps_p_rate,
+            temperature,
+            damage,
+        } = self;
+        let n = x0.len();
+        let columns = [weight.len(), body.len(), eroded.len(), f_carry_slot.len(), f.len(), tau.len(), pw.len()];
+        let more_columns = [pw_zz.len(), eps_p.len(), eps_p_rate.len(), temperature.len(), damage.len()];
+        columns.iter().chain(&more_columns).all(|&l| l == n)
+            && f_carry_slot.iter().all(|&s| s == NO_CARRY || (s as usize) < f_carry.len())
     }
 
     /// Append a point in the given state.

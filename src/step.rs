@@ -28,7 +28,7 @@ pub enum TimeStepRule {
 /// forces on them (`contact_work`); rigid bodies gain `rigid_kinetic` from
 /// the reactions (`rigid_work`). The sum `contact_work + rigid_work` is the
 /// energy the contact itself dissipated (≤ 0 for a well-behaved contact).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Energies {
     /// `½ Σ m_I |V_I|²` of the particles at the last full step (see
     /// `full_step_kinetic_terms`).
@@ -153,7 +153,7 @@ pub enum SolverError {
 pub const ENERGY_BLOWUP_FACTOR: Real = 2.0;
 
 /// The running simulation.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Simulation {
     pub model: Model,
     /// Simulated time, s.
@@ -163,12 +163,20 @@ pub struct Simulation {
     /// Time step, s.
     pub dt: Real,
     pub energies: Energies,
+    /// Wall-clock time per stage: not in checkpoints (a resumed run times
+    /// its own steps).
+    #[serde(skip)]
     pub timers: StageTimers,
     /// Speed above which a particle is declared runaway, m/s.
     pub speed_bound: Real,
     /// Contact with rigid bodies, if the case has any.
     pub contact: Option<ContactSystem>,
-    /// Heat conduction (SPEC §7), if the case asks for it.
+    /// Heat conduction (SPEC §7), if the case asks for it. Not in
+    /// checkpoints: it keeps no state between steps (each call rewrites its
+    /// scratch and report; its cached stable-step factor depends on the
+    /// reference configuration only) and is rebuilt from the case and the
+    /// model on reading, as a fresh run builds it.
+    #[serde(skip)]
     pub heat: Option<HeatConduction>,
     /// Some held (FIX_X / FIX_Y) component moves at a non-zero velocity:
     /// kinematic driving, whose work the energy account does not tally.
@@ -181,9 +189,13 @@ pub struct Simulation {
     pub f_contact: Vec<Vec2>,
     /// Crack growth (SPEC §9), if the case has a fracture criterion.
     pub cracks: Option<CrackGrowth>,
-    /// Per-point internal-energy increments of the last step (scratch).
+    /// Per-point internal-energy increments of the last step (scratch; this
+    /// and `kinetic_scratch` are not in checkpoints: each step resizes and
+    /// rewrites them before reading them).
+    #[serde(skip)]
     work_scratch: Vec<Real>,
     /// Per-particle full-step kinetic energies of the last step (scratch).
+    #[serde(skip)]
     kinetic_scratch: Vec<Real>,
 }
 
@@ -421,6 +433,9 @@ impl Simulation {
         let cracking = self.cracks.as_ref().is_some_and(|c| c.params.critical_value().is_some());
         // Erosion of inverted failed points (`crate::fracture` module doc).
         let erosion = self.cracks.as_ref().map(|c| c.params).filter(|p| cracking && p.erode_inverted);
+        // One increment per point (a simulation read from a checkpoint
+        // starts with none).
+        self.work_scratch.resize(self.model.quad.len(), 0.0);
         let m = &mut self.model;
         let (tab, u, v, mode, mats) = (&m.qp_shape, &m.particles.u, &m.particles.v, m.mode, &m.materials);
         let q = &mut m.quad;

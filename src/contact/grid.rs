@@ -15,7 +15,7 @@ use crate::math::{Real, Vec2};
 const BOUND_MARGIN: Real = 1e-9;
 
 /// Uniform grid of square cells over a point set.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PointGrid {
     /// Lower-left corner of cell (0, 0), m.
     origin: Vec2,

@@ -70,10 +70,7 @@ pub use rigid::{mass_axisymmetric, mass_plane_strain, rectangle_outline, RigidBo
 pub use search::{search_rigid_polygon, search_rigid_polygon_brute_force, Projection};
 pub use slave::{MasterFeature, Pairing, SlaveSet};
 pub use surface::{detect_surface, SurfaceDetection};
-pub use system::{
-    ActiveContact, BodySample, ContactAccumulators, ContactParameters, ContactSystem, StepInput, StepReport,
-    EXPOSED_REACH,
-};
+pub use system::{ActiveContact, BodySample, ContactParameters, ContactSystem, StepInput, StepReport, EXPOSED_REACH};
 
 use crate::math::Real;
 
@@ -96,6 +93,8 @@ pub enum ContactError {
     LengthMismatch { field: &'static str, expected: usize, found: usize },
     #[error("slave particle {particle} does not exist ({particles} particles)")]
     SlaveOutOfRange { particle: usize, particles: usize },
+    #[error("slave {slave}: {reason}")]
+    InvalidSlave { slave: usize, reason: &'static str },
     #[error("not a permutation: entry {position} repeats or exceeds the length")]
     InvalidPermutation { position: usize },
     #[error("spreading `{spreading:?}` needs the particle shape-function table")]

@@ -16,7 +16,7 @@ use super::ContactError;
 use crate::math::{Real, Vec2};
 
 /// A rigid body with a polygonal outline (SPEC §8).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RigidBody {
     /// Name used in messages and output.
     pub name: String,

@@ -14,7 +14,7 @@ use crate::math::{Real, Vec2};
 use crate::particles::ParticleFlags;
 
 /// A feature of a master outline that a slave is paired with.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum MasterFeature {
     /// Segment `k`, from vertex `k` to vertex `k + 1`.
     Segment(u32),
@@ -25,7 +25,7 @@ pub enum MasterFeature {
 }
 
 /// The pairing of a slave with a master feature of a rigid body.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub struct Pairing {
     /// Index of the rigid body.
     pub body: u32,
@@ -34,7 +34,7 @@ pub struct Pairing {
 }
 
 /// The slave particles, ascending and unique, with each one's last pairing.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SlaveSet {
     /// Particle index of slave `k`.
     particles: Vec<u32>,
@@ -159,6 +159,34 @@ impl SlaveSet {
             Some(&i) if i as usize >= n => Err(ContactError::SlaveOutOfRange { particle: i as usize, particles: n }),
             _ => Ok(()),
         }
+    }
+
+    /// Error unless the set is whole: the particles ascending, unique and
+    /// below `n`, one pairing per slave, each pairing naming a body (of
+    /// `vertices[b]` vertices, as many segments) and one of its features.
+    pub fn check(&self, n: usize, vertices: &[usize]) -> Result<(), ContactError> {
+        self.check_indices(n)?;
+        if let Some(k) = self.particles.windows(2).position(|w| w[0] >= w[1]) {
+            return Err(ContactError::InvalidSlave { slave: k + 1, reason: "particles not ascending" });
+        }
+        if self.pairing.len() != self.particles.len() {
+            return Err(ContactError::LengthMismatch {
+                field: "pairing",
+                expected: self.particles.len(),
+                found: self.pairing.len(),
+            });
+        }
+        for (k, p) in self.pairing.iter().enumerate() {
+            if let Some(Pairing { body, feature: MasterFeature::Segment(f) | MasterFeature::Vertex(f) }) = *p {
+                if vertices.get(body as usize).is_none_or(|&nv| f as usize >= nv) {
+                    return Err(ContactError::InvalidSlave {
+                        slave: k,
+                        reason: "paired with a feature that does not exist",
+                    });
+                }
+            }
+        }
+        Ok(())
     }
 }
 

@@ -196,7 +196,7 @@ impl<'a> StepInput<'a> {
 }
 
 /// One active contact of the last step (for diagnostics and tests).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ActiveContact {
     /// Slave particle.
     pub particle: u32,
@@ -250,22 +250,8 @@ pub struct StepReport {
     pub iterations: u32,
 }
 
-/// Per-body running sums of a [`ContactSystem`] (see
-/// [`ContactSystem::accumulators`]), one entry per rigid body.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct ContactAccumulators {
-    /// Cumulative work of each body's contact forces on the particles, J.
-    pub work_on_particles: Vec<Real>,
-    /// Cumulative work of the reactions on each body, J.
-    pub work_on_body: Vec<Real>,
-    /// Reaction on each body in the last step, N.
-    pub reaction: Vec<Vec2>,
-    /// Active contacts per body in the last step.
-    pub active_per_body: Vec<usize>,
-}
-
 /// Contact of the deformable particles with rigid bodies (SPEC §8).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ContactSystem {
     /// The rigid bodies (masters).
     pub bodies: Vec<RigidBody>,
@@ -289,13 +275,18 @@ pub struct ContactSystem {
     /// `Δt` and particle count of a `compute_forces` not yet followed by
     /// `advance`.
     pending: Option<(Real, usize)>,
-    /// Scratch: (particle, weight) of the gap point and of the spreading.
     /// Scratch: (particle, weight) rows of the gap points and, for
     /// inverse-distance spreading, of the forces; the pairs being solved.
+    /// Not in checkpoints (this and `gap_points`): cleared, or resized and
+    /// rewritten, at the start of every `compute_forces` before it is read.
+    #[serde(skip)]
     gap_w: Vec<(u32, Real)>,
+    #[serde(skip)]
     force_w: Vec<(u32, Real)>,
+    #[serde(skip)]
     candidates: Vec<Candidate>,
     /// Scratch: each slave's contact-free gap point of the current step.
+    #[serde(skip)]
     gap_points: Vec<GapPoint>,
 }
 
@@ -418,40 +409,26 @@ impl ContactSystem {
         })
     }
 
-    /// What the contact carries from one step to the next besides the
-    /// bodies and the slave set: the cumulative work and the last step's
-    /// reactions and contact counts (the history reports them). A checkpoint
-    /// stores these; everything else is rebuilt or recomputed each step.
-    pub fn accumulators(&self) -> ContactAccumulators {
-        ContactAccumulators {
-            work_on_particles: self.work_on_particles.clone(),
-            work_on_body: self.work_on_body.clone(),
-            reaction: self.reaction.clone(),
-            active_per_body: self.active_per_body.clone(),
-        }
-    }
-
-    /// Put back what [`Self::accumulators`] returned (resuming a run). Each
-    /// list must have one entry per body.
-    pub fn restore_accumulators(&mut self, a: ContactAccumulators) -> Result<(), ContactError> {
+    /// Error unless the state is one the steps can work on: one entry per
+    /// body in every per-body list, the slaves ascending particle indices
+    /// below `n` with one pairing each, every pairing naming a body and one
+    /// of its features (checks of a state read from a checkpoint).
+    pub fn check_state(&self, n: usize) -> Result<(), ContactError> {
         let nb = self.bodies.len();
         let lens = [
-            ("work_on_particles", a.work_on_particles.len()),
-            ("work_on_body", a.work_on_body.len()),
-            ("reaction", a.reaction.len()),
-            ("active_per_body", a.active_per_body.len()),
+            ("reaction", self.reaction.len()),
+            ("active_per_body", self.active_per_body.len()),
+            ("predicted_position", self.predicted_position.len()),
+            ("work_on_particles", self.work_on_particles.len()),
+            ("work_on_body", self.work_on_body.len()),
         ];
         for (field, found) in lens {
             if found != nb {
                 return Err(ContactError::LengthMismatch { field, expected: nb, found });
             }
         }
-        self.work_on_particles = a.work_on_particles;
-        self.work_on_body = a.work_on_body;
-        self.reaction = a.reaction;
-        self.active_per_body = a.active_per_body;
-        self.pending = None;
-        Ok(())
+        let vertices: Vec<usize> = self.bodies.iter().map(RigidBody::vertex_count).collect();
+        self.slaves.check(n, &vertices)
     }
 
     fn resize_per_body(&mut self) {

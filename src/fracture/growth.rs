@@ -63,7 +63,7 @@ fn angle(a: &Vec2, b: &Vec2) -> Real {
 }
 
 /// What happened to a crack.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum EventKind {
     Nucleate,
     Propagate,
@@ -81,7 +81,7 @@ impl EventKind {
 }
 
 /// One entry of the crack log.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CrackEvent {
     /// Simulated time, s.
     pub time: Real,
@@ -97,7 +97,7 @@ pub struct CrackEvent {
 }
 
 /// A vertex of a crack path.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CrackVertex {
     /// Reference position, m.
     pub x0: Vec2,
@@ -108,7 +108,7 @@ pub struct CrackVertex {
 
 /// A crack: a polyline in the reference configuration whose tip is a
 /// particle while it grows.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Crack {
     pub id: usize,
     pub vertices: Vec<CrackVertex>,
@@ -174,15 +174,20 @@ impl Crack {
 }
 
 /// The crack-growth stage: the cracks, their log, and the opaque segments.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct CrackGrowth {
     pub params: FractureParameters,
     pub cracks: Vec<Crack>,
     /// Every event, in order.
     pub events: Vec<CrackEvent>,
+    /// Not in checkpoints: rebuilt from the cracks on reading
+    /// ([`Self::refresh_segments`]).
+    #[serde(skip)]
     segments: CrackSegments,
     /// Reference positions binned for the circle searches (rebuilt when
-    /// particles move or are added).
+    /// particles move or are added). Not in checkpoints: rebuilt at its
+    /// next use.
+    #[serde(skip)]
     grid: Option<CellGrid>,
     /// Quadrature rows built with a reduced basis (too few visible
     /// particles next to a crack; [`super::rows`]).
@@ -192,7 +197,8 @@ pub struct CrackGrowth {
     /// Buffers that every local rebuild fills and swaps with the model's
     /// tables: the tables are rewritten after each split, and writing them
     /// into fresh allocations (page faults on tens of MB) took longer than
-    /// the copying itself.
+    /// the copying itself. Scratch, not in checkpoints.
+    #[serde(skip)]
     spare: Spare,
 }
 
@@ -261,32 +267,6 @@ impl CrackGrowth {
             reduced_particle_rows: BTreeMap::new(),
             spare: Spare::default(),
         }
-    }
-
-    /// The stage in a state read back from a checkpoint: the persistent
-    /// state as stored, the opaque segments rebuilt from the cracks (as
-    /// after a split) and the circle-search grid left to be rebuilt at its
-    /// next use. `model` is the restored model the cracks belong to.
-    pub fn from_state(
-        params: FractureParameters,
-        cracks: Vec<Crack>,
-        events: Vec<CrackEvent>,
-        reduced_quadrature_rows: BTreeMap<usize, Basis>,
-        reduced_particle_rows: BTreeMap<usize, Basis>,
-        model: &Model,
-    ) -> Self {
-        let mut growth = CrackGrowth {
-            params,
-            cracks,
-            events,
-            segments: CrackSegments::default(),
-            grid: None,
-            reduced_quadrature_rows,
-            reduced_particle_rows,
-            spare: Spare::default(),
-        };
-        growth.refresh_segments(model);
-        growth
     }
 
     /// The opaque segments of all cracks.

@@ -56,7 +56,7 @@ pub type Row = Vec<(u32, Real, Vec2)>;
 /// constant one (Shepard functions: partition of unity only)
 /// ([`row_with_fallback`]; SPEC §9, a deviation the fracture module
 /// documents).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
 pub enum Basis {
     /// `[1, Z_x, Z_y, Z_x Z_y]`, the method's basis ([RL10, Eq. (2.39)]).
     Bilinear,

@@ -9,7 +9,7 @@ use nalgebra::Matrix2;
 /// naming a particle `index[k]` with value `value[k]` and gradient `grad[k]`.
 /// Computed once in the reference configuration (total Lagrangian) and
 /// patched locally when a crack changes visibility.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ShapeTable {
     /// Row starts, length `rows + 1`.
     pub offsets: Vec<usize>,
