@@ -14,8 +14,9 @@
 //!   Runs stop early by `time.stop_after_release` ([`STOP_AFTER`]).
 //! - **Ballistic limit** `v_bl`: between the highest speed the plate held
 //!   and the lowest that perforated it. The search first checks the bracket
-//!   (`lo` must hold, `hi` perforate; otherwise it moves `lo` down by halves
-//!   or `hi` up by halves, up to [`WIDEN_TRIES`] times each), then each round
+//!   (`lo` must hold, `hi` perforate; otherwise it moves `lo` down to half
+//!   or `hi` up by half, up to [`WIDEN_TRIES`] times each, running `jobs`
+//!   speeds spread over the new part of the range at once), then each round
 //!   runs `jobs` speeds evenly spaced inside the bracket at once (two jobs
 //!   split it in three) and keeps the sub-bracket where the outcome changes,
 //!   until it is at most `2·tol` wide; `v_bl` is its middle, `± tol`.
@@ -509,15 +510,21 @@ pub fn find_limit(
             break;
         }
         let outcome = |v: Real, study: &Study| study.shots.iter().find(|s| s.speed == v).map(Shot::perforated);
+        // The `jobs` runs of a round spread over the new half of the range.
+        let n = setup.jobs.max(1);
         let mut more = Vec::new();
         if outcome(lo, study) == Some(true) {
+            more.extend((1..=n).map(|k| lo * (1.0 - 0.5 * k as Real / n as Real)));
             lo *= 0.5;
-            more.push(lo);
         }
         if outcome(hi, study) == Some(false) {
+            more.extend((1..=n).map(|k| hi * (1.0 + 0.5 * k as Real / n as Real)));
             hi *= 1.5;
-            more.push(hi);
         }
+        let more = more.into_iter().map(|v| (v * 100.0).round() / 100.0).collect::<Vec<_>>();
+        let (lo_now, hi_now) = (lo, hi);
+        lo = more.iter().copied().filter(|&v| v <= lo_now * 1.000_001).fold(lo_now, Real::min);
+        hi = more.iter().copied().filter(|&v| v >= hi_now * 0.999_999).fold(hi_now, Real::max);
         if more.is_empty() {
             break;
         }
@@ -740,4 +747,84 @@ pub fn write_files(
     crate::io::save_line_plot(&png, &plot(study, title, experiments))?;
     files.push(png);
     Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn synthetic(a: Real, p: Real, v_bl: Real, speeds: &[Real]) -> Vec<(Real, Real)> {
+        speeds.iter().map(|&v| (v, recht_ipson(v, a, p, v_bl))).collect()
+    }
+
+    #[test]
+    fn the_fit_recovers_known_parameters() {
+        let speeds = [190.0, 200.0, 220.0, 250.0, 280.0, 320.0];
+        let f = fit_recht_ipson(&synthetic(0.8, 2.5, 180.0, &speeds), 170.0).unwrap();
+        assert!((f.a - 0.8).abs() < 2e-3 && (f.p - 2.5).abs() < 2e-2 && (f.v_bl - 180.0).abs() < 0.2, "{f:?}");
+        assert!(f.rms < 0.05 && !f.p_fixed && f.points == 6, "{f:?}");
+        // The classic rigid-plug curve, a = 1, p = 2.
+        let f = fit_recht_ipson(&synthetic(1.0, 2.0, 150.0, &speeds), 0.0).unwrap();
+        assert!((f.a - 1.0).abs() < 1e-3 && (f.p - 2.0).abs() < 1e-2 && (f.v_bl - 150.0).abs() < 0.2, "{f:?}");
+        // Noisy points: still close.
+        let noisy: Vec<(Real, Real)> = synthetic(0.9, 2.0, 160.0, &speeds)
+            .iter()
+            .enumerate()
+            .map(|(k, p)| (p.0, p.1 + [0.5, -0.5][k % 2]))
+            .collect();
+        let f = fit_recht_ipson(&noisy, 0.0).unwrap();
+        assert!((f.v_bl - 160.0).abs() < 10.0 && (f.a - 0.9).abs() < 0.05 && f.rms < 1.0, "{f:?}");
+    }
+
+    #[test]
+    fn the_fit_keeps_v_bl_in_the_bracket_and_needs_points() {
+        // Held at 185 m/s: v_bl may not be below it, even if the points say 180.
+        let pts = synthetic(0.8, 2.5, 180.0, &[190.0, 220.0, 260.0, 300.0]);
+        let f = fit_recht_ipson(&pts, 185.0).unwrap();
+        assert!(f.v_bl >= 185.0 && f.v_bl <= 190.0, "{f:?}");
+        // Two points: p held at 2, the curve through both.
+        let f = fit_recht_ipson(&synthetic(0.7, 2.0, 100.0, &[150.0, 250.0]), 0.0).unwrap();
+        assert!(f.p_fixed && f.p == 2.0 && (f.v_bl - 100.0).abs() < 0.1 && f.rms < 1e-2, "{f:?}");
+        assert_eq!(fit_recht_ipson(&[(200.0, 100.0), (150.0, 0.0)], 0.0), None);
+    }
+
+    fn shot(speed: Real, verdict: Verdict) -> Shot {
+        Shot {
+            speed,
+            verdict,
+            perforation: None,
+            plug_mass: None,
+            end_time: 0.0,
+            steps: 0,
+            wall: 0.0,
+            dir: PathBuf::new(),
+        }
+    }
+
+    #[test]
+    fn the_bracket_is_the_highest_hold_below_the_lowest_perforation() {
+        let held = Verdict::Held { since: 0.0 };
+        let perf = |v| Verdict::Perforated { residual: v, since: 0.0 };
+        let shots = vec![shot(100.0, held), shot(150.0, held), shot(200.0, perf(50.0)), shot(300.0, perf(200.0))];
+        assert_eq!(bracket(&shots), (Some(150.0), Some(200.0), None));
+        let pushing = Verdict::Undecided { speed: 20.0, plug: true, free: false };
+        let shots = vec![shot(150.0, held), shot(170.0, pushing), shot(180.0, held)];
+        assert_eq!(bracket(&shots), (Some(150.0), Some(170.0), Some(180.0)));
+        let limit = Limit { held: Some(150.0), perforated: Some(170.0), tol: 1.0, non_monotonic: None };
+        assert_eq!(limit.estimate(), Some((160.0, 10.0)));
+    }
+
+    #[test]
+    fn experimental_points_need_their_header() {
+        let dir = std::env::temp_dir().join(format!("plugsim-experiments-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("e.csv");
+        std::fs::write(&path, "# source\nv_i,v_r\n200.0, 100.5\n150,0 # held\n").unwrap();
+        assert_eq!(read_experiments(&path).unwrap(), vec![(200.0, 100.5), (150.0, 0.0)]);
+        std::fs::write(&path, "200,100\n").unwrap();
+        assert!(read_experiments(&path).unwrap_err().to_string().contains("header"));
+        std::fs::write(&path, "v_i,v_r\n200,x\n").unwrap();
+        assert!(read_experiments(&path).unwrap_err().to_string().contains("line 2"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

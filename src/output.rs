@@ -353,14 +353,15 @@ impl OutputWriter {
 
     /// Whether every moving rigid body's flight is over, by the definitions
     /// of [`crate::residual`] held for `wait` (s): stopped or moving back, or
-    /// (once a plug has been cut out) free of force along its flight. Call
+    /// free of force along its flight with a plug cut out (both for `wait`:
+    /// the plug, thrown ahead, may still be caught again). Call
     /// after every step (`time.stop_after_release`); false without a
     /// moving rigid body (one with an initial velocity, not prescribed).
     pub fn flights_over(&mut self, sim: &Simulation, wait: Real) -> bool {
         let Some(contact) = &sim.contact else {
             return false;
         };
-        let cut = self.plug.first_cut.is_some();
+        let cut = self.plug.first_cut;
         let mut moving = 0;
         let mut over = 0;
         for b in 0..contact.bodies.len().min(self.release.len()) {
@@ -372,7 +373,9 @@ impl OutputWriter {
             let tracker = &mut self.release[b];
             tracker.observe(sim.time, s.contact_force.dot(&dir), s.velocity.dot(&dir), impact);
             let stopped = tracker.stopped_for(sim.time).is_some_and(|t| t >= wait);
-            let free = cut && tracker.free_for(sim.time).is_some_and(|t| t >= wait);
+            // Free for `wait` since the later of the release and the cut.
+            let free =
+                cut.is_some_and(|c| sim.time - c >= wait) && tracker.free_for(sim.time).is_some_and(|t| t >= wait);
             moving += 1;
             over += usize::from(stopped || free);
         }
