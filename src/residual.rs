@@ -174,17 +174,18 @@ pub fn verdict(samples: impl IntoIterator<Item = (Real, Real, Real)>, impact_spe
 }
 
 /// The verdict of rigid body `name` from a run's history, given its flight
-/// direction (unit, or zero) and impact speed (m/s).
+/// direction (unit, or zero), impact speed (m/s) and whether a plug was cut
+/// out.
 pub fn verdict_from_history(
     table: &crate::io::HistoryTable,
     name: &str,
     flight: Vec2,
     impact_speed: Real,
+    plug: bool,
 ) -> Option<Verdict> {
     let t = table.column("time")?;
     let f = table.column(&format!("{name}_f_axial"))?;
     let (vx, vy) = (table.column(&format!("{name}_vx"))?, table.column(&format!("{name}_vy"))?);
-    let plug = crate::output::perforation_time(table).is_some();
     let samples = (0..t.len()).map(|k| (t[k], f[k], vx[k] * flight.x + vy[k] * flight.y));
     Some(verdict(samples, impact_speed, plug))
 }

@@ -488,7 +488,8 @@ fn time_loop(
         .into_iter()
         .filter_map(|(name, v0)| {
             let dir = crate::residual::flight_direction(v0);
-            let verdict = crate::residual::verdict_from_history(&history, &name, dir, v0.norm())?;
+            let verdict =
+                crate::residual::verdict_from_history(&history, &name, dir, v0.norm(), perforation.is_some())?;
             Some((name, verdict))
         })
         .collect();
