@@ -672,6 +672,20 @@ pub fn report(header: &str, study: &Study) -> String {
             (None, None, Some(hi)) => s.push_str(&format!("Ballistic limit not bracketed: every speed perforated, down to {hi:.2} m/s.\n\n")),
             _ => s.push_str("Ballistic limit: no finished runs.\n\n"),
         }
+        let undecided = study
+            .shots
+            .iter()
+            .find(|x| Some(x.speed) == l.held)
+            .filter(|x| matches!(x.verdict, Verdict::Undecided { .. }));
+        if let Some(x) = undecided {
+            s.push_str(&format!(
+                "Warning: the held side of the bracket ({:.2} m/s) is a run still moving along its flight at its end \
+                 ({:.1} us) without a plug cut out: this is the limit of perforation within that time; raise \
+                 `time.end` (`--set time.end=...`) for the physical limit.\n\n",
+                x.speed,
+                x.end_time * 1e6
+            ));
+        }
         if let Some(v) = l.non_monotonic {
             s.push_str(&format!("Note: the plate held at {v:.2} m/s, above the lowest perforating speed.\n\n"));
         }
