@@ -227,10 +227,12 @@ pub struct TimeSpec {
     /// A fixed step, s, overriding the CFL rule (\[RL10\] used 4e-9 s).
     #[serde(default)]
     pub fixed_dt: Option<Real>,
-    /// Stop early, s: once a plug has been cut out and the first rigid
-    /// body has had no contact, both for this long, the run ends there
-    /// instead of at `end` (its speed no longer changes). Default: run to
-    /// `end`.
+    /// Stop early, s: the run ends once every moving rigid body's flight is
+    /// over for this long ([`crate::residual`]): a plug has been cut out and
+    /// the contact force along the body's flight direction has vanished
+    /// (its speed no longer changes; a touch on the side wall of the hole
+    /// does not count), or the body has stopped or bounced back (the plate
+    /// held). Default: run to `end`.
     #[serde(default)]
     pub stop_after_release: Option<Real>,
 }
@@ -684,6 +686,12 @@ impl Case {
     /// All rigid bodies.
     pub fn rigid_bodies(&self) -> Result<Vec<RigidBody>, ContactError> {
         self.rigid_bodies.iter().map(|rb| self.rigid_body(rb)).collect()
+    }
+
+    /// Each rigid body's name and initial velocity (its flight direction,
+    /// [`crate::residual`]), m/s.
+    pub fn rigid_flights(&self) -> Vec<(String, Vec2)> {
+        self.rigid_bodies.iter().map(|rb| (rb.name.clone(), Vec2::new(rb.velocity[0], rb.velocity[1]))).collect()
     }
 
     /// The time-step rule.

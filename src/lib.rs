@@ -2,6 +2,7 @@
 //! plugging and ductile fracture. See `ARCHITECTURE.md` for the module map
 //! and `SPEC.md` (shared) for the physics.
 
+pub mod ballistic;
 pub mod bench;
 pub mod case;
 pub mod cases;
@@ -22,6 +23,7 @@ pub mod output;
 pub mod particles;
 pub mod plug;
 pub mod quadrature;
+pub mod residual;
 pub mod run;
 pub mod shape;
 pub mod step;

@@ -76,6 +76,46 @@ enum Command {
         #[arg(long)]
         full_time: bool,
     },
+    /// Run a case with a rigid projectile at several impact speeds and/or find
+    /// its ballistic limit by bisection; writes ballistic.csv, ballistic.md
+    /// (table, Recht-Ipson fit) and ballistic.png, and each run's directory.
+    Ballistic {
+        /// Case file (TOML).
+        case_file: Option<PathBuf>,
+        /// A built-in case by name (see `plugsim cases`).
+        #[arg(long, conflicts_with = "case_file")]
+        case: Option<String>,
+        /// Impact speeds to run, m/s (comma-separated).
+        #[arg(long, value_delimiter = ',')]
+        speeds: Vec<f64>,
+        /// Find the ballistic limit by bisection.
+        #[arg(long)]
+        limit: bool,
+        /// Lower end of the search, m/s (default: half the case's impact speed).
+        #[arg(long, requires = "limit")]
+        lo: Option<f64>,
+        /// Upper end of the search, m/s (default: the case's impact speed).
+        #[arg(long, requires = "limit")]
+        hi: Option<f64>,
+        /// Tolerance of the limit, +- m/s.
+        #[arg(long, default_value_t = 1.0, requires = "limit")]
+        tol: f64,
+        /// The rigid body to fire (default: the case's only moving one).
+        #[arg(long)]
+        projectile: Option<String>,
+        /// Runs side by side (default: one per core, one thread each).
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// Override a case value, e.g. --set time.end=2e-4 (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Output directory (default: runs/ballistic-<case name>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Experimental points to plot: a CSV with header v_i,v_r (m/s).
+        #[arg(long)]
+        experiments: Option<PathBuf>,
+    },
     /// Benchmark fixed workloads: shape functions, material kernel, force
     /// assembly, whole steps (1 and all threads), optionally whole cases.
     Bench {
@@ -205,6 +245,11 @@ fn list_cases() -> Result<()> {
 fn dispatch(cmd: Command) -> Result<()> {
     match cmd {
         Command::Cases => list_cases(),
+        Command::Ballistic { case_file, case, speeds, limit, lo, hi, tol, projectile, jobs, set, out, experiments } => {
+            let (case, name, file) = load(&case_file, &case, &set)?;
+            let args = BallisticArgs { speeds, limit, lo, hi, tol, projectile, jobs, experiments };
+            ballistic(case, &name, &file, &set, out, args)
+        }
         Command::Bench { case, steps, whole, set } => bench(&case, steps, whole, &set),
         Command::Validate { out, all, only, full_time } => validate(&out, all, only.as_deref(), full_time),
         Command::MaterialPoint { material, case_file, path, rate, strain, dt, out } => {
@@ -349,6 +394,111 @@ fn validate(out: &Path, all: bool, only: Option<&str>, full_time: bool) -> Resul
     std::fs::write(out.join("validation.csv"), &csv)?;
     println!("{md}");
     println!("written: {0}/validation.md, {0}/validation.csv and the plots beside them", out.display());
+    Ok(())
+}
+
+/// `plugsim ballistic`'s options besides the case.
+struct BallisticArgs {
+    speeds: Vec<f64>,
+    limit: bool,
+    lo: Option<f64>,
+    hi: Option<f64>,
+    tol: f64,
+    projectile: Option<String>,
+    jobs: Option<usize>,
+    experiments: Option<PathBuf>,
+}
+
+fn ballistic(
+    case: Case,
+    name: &str,
+    file: &str,
+    set: &[String],
+    out: Option<PathBuf>,
+    args: BallisticArgs,
+) -> Result<()> {
+    use plugsim::ballistic::{find_limit, flight, read_experiments, run_speeds, select_projectile, write_files};
+    use plugsim::ballistic::{Event, Setup, Study};
+    let projectile = select_projectile(&case, file, args.projectile.as_deref())?;
+    if args.speeds.is_empty() && !args.limit {
+        bail!("give --speeds V1,V2,... and/or --limit");
+    }
+    if let Some(v) = args.speeds.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
+        bail!("impact speeds must be positive numbers (got {v})");
+    }
+    let experiments = match &args.experiments {
+        Some(p) => read_experiments(p)?,
+        None => Vec::new(),
+    };
+    let (_, impact) = flight(&case, projectile);
+    let cores = rayon::current_num_threads().max(1);
+    let jobs = args.jobs.unwrap_or(cores).max(1);
+    let threads_per_run = (cores / jobs).max(1);
+    let out_dir = out.unwrap_or_else(|| Path::new("runs").join(format!("ballistic-{name}")));
+    std::fs::create_dir_all(&out_dir).with_context(|| format!("cannot create {}", out_dir.display()))?;
+    let setup = Setup {
+        case,
+        label: file.to_string(),
+        overrides: set.to_vec(),
+        projectile,
+        jobs,
+        threads_per_run,
+        out_dir: out_dir.clone(),
+        interrupt: install_interrupt_handler(),
+    };
+    let body = &setup.case.rigid_bodies[projectile].name;
+    let header = format!(
+        "Case {file}{}; projectile `{body}` (case impact speed {impact:.1} m/s); {jobs} runs side by side, {threads_per_run} thread(s) each; \
+         produced by `plugsim ballistic` ({} {}) on {}.",
+        if set.is_empty() { String::new() } else { format!(" with {}", set.join(" ")) },
+        env!("CARGO_PKG_VERSION"),
+        env!("PLUGSIM_COMMIT"),
+        cpu_name()
+    );
+    let title = format!("{}: residual against impact velocity", setup.case.title);
+    let mut report = |study: &Study| write_files(&out_dir, &header, &title, study, &experiments).map(|_| ());
+    let started = Instant::now();
+    let mut progress = |e: Event| {
+        let at = started.elapsed().as_secs_f64();
+        match e {
+            Event::Round { label, speeds } => {
+                let v: Vec<String> = speeds.iter().map(|v| format!("{v:.2}")).collect();
+                eprintln!("[{at:6.0} s] {label}: {} m/s", v.join(", "));
+            }
+            Event::Started { speed } => eprintln!("[{at:6.0} s]   {speed:.2} m/s started"),
+            Event::Advanced { speed, time, end } => {
+                eprintln!("[{at:6.0} s]   {speed:.2} m/s at {:.1} of {:.1} us", time * 1e6, end * 1e6)
+            }
+            Event::Finished { shot } => eprintln!(
+                "[{at:6.0} s]   {:.2} m/s: {}{} ({:.1} s)",
+                shot.speed,
+                shot.outcome(),
+                shot.residual().map(|v| format!(", v_r = {v:.2} m/s")).unwrap_or_default(),
+                shot.wall
+            ),
+            Event::Failed { speed, message } => eprintln!("[{at:6.0} s]   {speed:.2} m/s failed: {message}"),
+            Event::Interrupted { speed } => eprintln!("[{at:6.0} s]   {speed:.2} m/s interrupted"),
+        }
+    };
+    eprintln!(
+        "plugsim ballistic: {jobs} runs side by side ({threads_per_run} thread(s) each) into {}",
+        out_dir.display()
+    );
+    let mut study = Study::default();
+    run_speeds(&setup, &args.speeds, &mut study, &mut report, &mut progress)?;
+    if args.limit && !study.interrupted {
+        let bounds = (args.lo.unwrap_or(0.5 * impact), args.hi.unwrap_or(impact));
+        find_limit(&setup, bounds, args.tol, &mut study, &mut report, &mut progress)?;
+    }
+    let files = write_files(&out_dir, &header, &title, &study, &experiments)?;
+    println!("{}", plugsim::ballistic::report(&header, &study));
+    println!("total wall time {:.1} s", started.elapsed().as_secs_f64());
+    for f in files {
+        println!("written: {}", f.display());
+    }
+    if study.interrupted {
+        bail!("interrupted: the table keeps the {} runs finished before it", study.shots.len());
+    }
     Ok(())
 }
 
@@ -611,13 +761,16 @@ fn drive(
     );
     for ((name, v), (_, last)) in s.rigid_velocities.iter().zip(&s.last_contacts) {
         let contact = match last {
-            Some(t) if s.time - t > 1e-9 => {
-                format!("last contact at {:.2} us (its residual velocity if none follows)", t * 1e6)
-            }
-            Some(_) => "still in contact at the end".to_string(),
+            Some(t) if s.time - t > 1e-9 => format!("last contact of any kind at {:.2} us", t * 1e6),
+            Some(_) => "in contact at the end".to_string(),
             None => "never in contact".to_string(),
         };
         println!("  rigid body {name}: final velocity ({:.2}, {:.2}) m/s; {contact}", v[0], v[1]);
+        if let Some((_, verdict)) = s.flights.iter().find(|(n, _)| n == name) {
+            if *verdict != plugsim::residual::Verdict::NotMoving {
+                println!("    {}", verdict.describe());
+            }
+        }
     }
     for (id, nucleated, arrested) in &s.cracks {
         match arrested {

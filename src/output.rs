@@ -37,7 +37,10 @@ pub enum OutputError {
 /// contact slaves by exposure so far, and `exposed_contacts`, how many of
 /// them touched a rigid body in the last step (see
 /// [`crate::contact::ContactSystem::admit_exposed`]). Each rigid body `NAME` adds `NAME_x, NAME_y` (m), `NAME_vx, NAME_vy` (m/s),
-/// `NAME_fx, NAME_fy` (contact force on the body, N) and `NAME_contacts`.
+/// `NAME_fx, NAME_fy` (contact force on the body, N), `NAME_contacts` and
+/// `NAME_f_axial`, the contact force along its flight direction (the
+/// direction of its initial velocity; negative while braked; 0 for a body
+/// that started at rest), N ([`crate::residual`]).
 pub const HISTORY_COLUMNS: &[&str] = &[
     "time",
     "step",
@@ -66,7 +69,7 @@ pub const HISTORY_COLUMNS: &[&str] = &[
 pub const CRACK_COLUMNS: &[&str] = &["time", "step", "crack", "kind", "particles", "value"];
 
 /// Per-rigid-body history column suffixes.
-pub const RIGID_COLUMNS: &[&str] = &["x", "y", "vx", "vy", "fx", "fy", "contacts"];
+pub const RIGID_COLUMNS: &[&str] = &["x", "y", "vx", "vy", "fx", "fy", "contacts", "f_axial"];
 
 /// All history columns for a run with the given rigid bodies.
 pub fn history_columns(rigid_names: &[String]) -> Vec<String> {
@@ -92,8 +95,10 @@ pub struct OutputWriter {
     crack_events_written: usize,
     /// The plug, followed from step to step.
     plug: crate::plug::PlugTracker,
-    /// Time of the last step with contacts on the first rigid body, s.
-    last_contact: Option<Real>,
+    /// Each rigid body's initial velocity (its flight), m/s.
+    flights: Vec<Vec2>,
+    /// Each rigid body's release, followed every step ([`crate::residual`]).
+    release: Vec<crate::residual::ReleaseTracker>,
     /// Step of the last history row (a step gets at most one).
     last_row_step: Option<u64>,
     /// The last snapshot, while its files are written on a thread of their
@@ -110,9 +115,11 @@ struct PendingSnapshot {
 }
 
 impl OutputWriter {
-    /// Start the series `results.pvd` and `history.csv` in `dir` (which must exist).
-    pub fn create(dir: &Path, fields: &[String], rigid_names: &[String]) -> Result<Self, IoError> {
-        let cols = history_columns(rigid_names);
+    /// Start the series `results.pvd` and `history.csv` in `dir` (which
+    /// must exist); `rigid` names each rigid body with its initial velocity.
+    pub fn create(dir: &Path, fields: &[String], rigid: &[(String, Vec2)]) -> Result<Self, IoError> {
+        let rigid_names: Vec<String> = rigid.iter().map(|r| r.0.clone()).collect();
+        let cols = history_columns(&rigid_names);
         let cols: Vec<&str> = cols.iter().map(|s| s.as_str()).collect();
         Ok(OutputWriter {
             dir: dir.to_path_buf(),
@@ -123,7 +130,8 @@ impl OutputWriter {
             crack_log: None,
             crack_events_written: 0,
             plug: Default::default(),
-            last_contact: None,
+            flights: rigid.iter().map(|r| r.1).collect(),
+            release: vec![Default::default(); rigid.len()],
             last_row_step: None,
             pending: None,
         })
@@ -136,15 +144,17 @@ impl OutputWriter {
     /// first `history_bytes` bytes (the rows up to the checkpoint) and
     /// continued, and `cracks.csv` is rewritten with the events of `cracks`
     /// (those up to the checkpoint; removed if there are none) and continued.
+    /// The rigid bodies' releases are followed on from the rows kept.
     pub fn resume(
         dir: &Path,
         fields: &[String],
-        rigid_names: &[String],
+        rigid: &[(String, Vec2)],
         snapshot_times: &[Real],
         history_bytes: u64,
         cracks: Option<&crate::fracture::CrackGrowth>,
     ) -> Result<Self, IoError> {
-        let cols = history_columns(rigid_names);
+        let rigid_names: Vec<String> = rigid.iter().map(|r| r.0.clone()).collect();
+        let cols = history_columns(&rigid_names);
         let cols: Vec<&str> = cols.iter().map(|s| s.as_str()).collect();
         let history = HistoryWriter::continue_at(&dir.join("history.csv"), &cols, history_bytes)?;
         // The perforation time so far is in the rows kept (the last row's
@@ -186,7 +196,8 @@ impl OutputWriter {
             crack_log: None,
             crack_events_written: 0,
             plug: crate::plug::PlugTracker::continuing(first_cut),
-            last_contact: None,
+            flights: rigid.iter().map(|r| r.1).collect(),
+            release: replay_releases(&kept, rigid),
             last_row_step,
             pending: None,
         };
@@ -314,6 +325,7 @@ impl OutputWriter {
                     s.contact_force.x,
                     s.contact_force.y,
                     s.active_contacts as Real,
+                    s.contact_force.dot(&self.flight_direction(b)),
                 ]);
             }
         }
@@ -351,17 +363,41 @@ impl OutputWriter {
         Ok(())
     }
 
-    /// How long the first rigid body has been free of contact and the plug
-    /// cut out (time since the later of the two), s (`None` before the plug, while in contact, or if it
-    /// never touched). Call after every step (`time.stop_after_release`).
-    pub fn released_for(&mut self, sim: &Simulation) -> Option<Real> {
-        let contacts = sim.contact.as_ref().and_then(|c| c.sample(0)).map(|s| s.active_contacts)?;
-        if contacts > 0 {
-            self.last_contact = Some(sim.time);
+    /// Whether every moving rigid body's flight is over, by the definitions
+    /// of [`crate::residual`] held for `wait` (s): stopped or moving back, or
+    /// free of force along its flight with a plug cut out (both for `wait`:
+    /// the plug, thrown ahead, may still be caught again). Call
+    /// after every step (`time.stop_after_release`); false without a
+    /// moving rigid body (one with an initial velocity, not prescribed).
+    pub fn flights_over(&mut self, sim: &Simulation, wait: Real) -> bool {
+        let Some(contact) = &sim.contact else {
+            return false;
+        };
+        let cut = self.plug.first_cut;
+        let mut moving = 0;
+        let mut over = 0;
+        for b in 0..contact.bodies.len().min(self.release.len()) {
+            let impact = self.flights[b].norm();
+            if impact == 0.0 || contact.bodies[b].prescribed_velocity.is_some() {
+                continue;
+            }
+            let (s, dir) = (contact.sample(b).expect("body exists"), self.flight_direction(b));
+            let tracker = &mut self.release[b];
+            tracker.observe(sim.time, s.contact_force.dot(&dir), s.velocity.dot(&dir), impact);
+            let stopped = tracker.stopped_for(sim.time).is_some_and(|t| t >= wait);
+            // Free for `wait` since the later of the release and the cut.
+            let free =
+                cut.is_some_and(|c| sim.time - c >= wait) && tracker.free_for(sim.time).is_some_and(|t| t >= wait);
+            moving += 1;
+            over += usize::from(stopped || free);
         }
-        let cut = self.plug.first_cut?;
-        let free = sim.time - self.last_contact?.max(cut);
-        (free > 0.0).then_some(free)
+        moving > 0 && over == moving
+    }
+
+    /// Unit vector along rigid body `b`'s initial velocity (zero if it
+    /// started at rest).
+    fn flight_direction(&self, b: usize) -> Vec2 {
+        self.flights.get(b).map_or_else(Vec2::zeros, |&v| crate::residual::flight_direction(v))
     }
 
     /// Append the events of `cracks` not yet written to `cracks.csv`.
@@ -388,6 +424,25 @@ impl OutputWriter {
         self.crack_events_written = cracks.events.len();
         Ok(())
     }
+}
+
+/// The rigid bodies' release trackers after the rows of `table` (a resumed
+/// run continues them; the live ones see every step, these every history row).
+fn replay_releases(table: &crate::io::HistoryTable, rigid: &[(String, Vec2)]) -> Vec<crate::residual::ReleaseTracker> {
+    let time = table.column("time").unwrap_or_default();
+    rigid
+        .iter()
+        .map(|(name, v0)| {
+            let mut tracker = crate::residual::ReleaseTracker::default();
+            let dir = crate::residual::flight_direction(*v0);
+            let col = |c: &str| table.column(&format!("{name}_{c}")).unwrap_or_default();
+            let (f, vx, vy) = (col("f_axial"), col("vx"), col("vy"));
+            for k in 0..time.len().min(f.len()).min(vx.len()).min(vy.len()) {
+                tracker.observe(time[k], f[k], vx[k] * dir.x + vy[k] * dir.y, v0.norm());
+            }
+            tracker
+        })
+        .collect()
 }
 
 /// The cracks as poly-lines in the current configuration: two per crack

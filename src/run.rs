@@ -115,6 +115,9 @@ pub struct RunSummary {
     pub rigid_velocities: Vec<(String, [Real; 2])>,
     /// Time of each rigid body's last contact (history rows), s.
     pub last_contacts: Vec<(String, Option<Real>)>,
+    /// How each rigid body's flight ended: perforated with its residual
+    /// velocity, held, or undecided ([`crate::residual`], from the history).
+    pub flights: Vec<(String, crate::residual::Verdict)>,
 }
 
 /// Why a run stopped.
@@ -268,8 +271,7 @@ pub fn execute(case: &Case, cfg: &RunConfig, progress: &mut dyn FnMut(Progress))
     };
     write("case.resolved.toml", case.resolved_toml())?;
     write("run_info.toml", toml::to_string_pretty(&cfg.info).unwrap_or_default())?;
-    let rigid_names: Vec<String> = case.rigid_bodies.iter().map(|r| r.name.clone()).collect();
-    let out = OutputWriter::create(&cfg.out_dir, &case.output.fields, &rigid_names)?;
+    let out = OutputWriter::create(&cfg.out_dir, &case.output.fields, &case.rigid_flights())?;
     let schedule = Schedule {
         next_snapshot: 0.0,
         next_checkpoint: case.checkpoint.interval.unwrap_or(Real::INFINITY),
@@ -294,11 +296,10 @@ pub fn resume(cfg: &RunConfig, progress: &mut dyn FnMut(Progress)) -> Result<Run
              to an uninterrupted run only with the same build"
         ));
     }
-    let rigid_names: Vec<String> = case.rigid_bodies.iter().map(|r| r.name.clone()).collect();
     let out = OutputWriter::resume(
         &cfg.out_dir,
         &case.output.fields,
-        &rigid_names,
+        &case.rigid_flights(),
         &saved.snapshot_times,
         saved.history_bytes,
         sim.cracks.as_ref(),
@@ -460,7 +461,7 @@ fn time_loop(
             return Err(RunError::Unstable { error, last_snapshot: last, dir: cfg.out_dir.clone() });
         }
         if let Some(wait) = case.time.stop_after_release {
-            released = out.released_for(&sim).is_some_and(|free| free >= wait);
+            released = out.flights_over(&sim, wait);
         }
         if sim.step.is_multiple_of(report_every) {
             progress(Progress::Step { sim: &sim });
@@ -491,6 +492,16 @@ fn time_loop(
     let history = crate::output::read_history(&cfg.out_dir)?;
     let last_contacts = crate::output::last_contact_times(&history, &names);
     let perforation = crate::output::perforation_time(&history);
+    let flights = case
+        .rigid_flights()
+        .into_iter()
+        .filter_map(|(name, v0)| {
+            let dir = crate::residual::flight_direction(v0);
+            let verdict =
+                crate::residual::verdict_from_history(&history, &name, dir, v0.norm(), perforation.is_some())?;
+            Some((name, verdict))
+        })
+        .collect();
     let plug = match (&sim.cracks, crate::output::impact_line(&sim)) {
         (Some(c), Some(axis_x)) => crate::plug::find_plug(&sim.model, c, axis_x),
         _ => None,
@@ -504,6 +515,7 @@ fn time_loop(
         separation,
         rigid_velocities,
         last_contacts,
+        flights,
         plots,
         particles: sim.model.particles.len(),
         quadrature_points: sim.model.quad.len(),

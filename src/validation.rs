@@ -4,14 +4,16 @@
 //! (shared/reference/ren-li-2010.toml, Tables 1 and 3).
 //!
 //! What each row measures, as experimenters do:
-//! - **Residual velocity**: the projectile's speed once contact forces have
-//!   vanished. Detected from the run's `history.csv`: the last row whose
-//!   `projectile_contacts` (slave particles pushing on the projectile, i.e.
-//!   a non-zero contact force) is positive is the *last contact*; the
-//!   residual is the speed at the end of the run, reported only if the run
-//!   went on for at least [`FREE_FLIGHT`] after the last contact (with no
-//!   force and no gravity the speed is then constant). Otherwise the row says
-//!   "in contact at the end" with the final speed in brackets.
+//! - **Residual velocity**: the projectile's speed along its flight
+//!   direction once the contact force along that direction has vanished
+//!   ([`crate::residual`]): from the run's `history.csv`, the projectile is
+//!   *released* once its `projectile_f_axial` has stayed below 0.1 % of its
+//!   peak for at least [`FREE_FLIGHT`] before the end of the run, with a plug
+//!   cut out; the residual is its speed along the flight at the end. A touch
+//!   on the side wall of the hole does not count (it pushes across the
+//!   flight). A projectile that stopped or bounced back reports 0, "held".
+//!   Otherwise the row says "in contact at the end" with the final speed
+//!   along the flight in brackets.
 //! - **Perforation time**: when the plate is first completely severed — the
 //!   time of the step after which the flood fill of [`crate::plug`] first
 //!   finds a plug (it runs after every step that changed the cracks; the
@@ -27,14 +29,11 @@ use crate::case::Case;
 use crate::cases::{borvik_family, builtin_case, resolve_alias, BorvikCase};
 use crate::io::{HistoryTable, LinePlot, Series};
 use crate::math::Real;
+use crate::residual::Verdict;
 use crate::run::{execute, RunConfig, RunError, RunInfo, RunSummary};
 use std::path::{Path, PathBuf};
 
-/// How long the projectile must fly free of contact before the end of the
-/// run for its speed to count as the residual velocity, s: several history
-/// rows (a row every ten steps of about 0.04 µs), so a contact that only
-/// paused between two rows is not taken for the end of contact.
-pub const FREE_FLIGHT: Real = 1.0e-6;
+pub use crate::residual::FREE_FLIGHT;
 
 /// One of Børvik's experiments as printed in \[RL10\] (reference file).
 #[derive(Clone, Debug)]
@@ -154,23 +153,20 @@ pub struct Outcome {
     pub result: Result<RunSummary, String>,
     /// Wall time of the run, s.
     pub wall: Real,
-    /// Projectile speed at the end, m/s.
-    pub final_speed: Option<Real>,
-    /// Time of its last contact, s.
+    /// How the projectile's flight ended ([`crate::residual`]).
+    pub verdict: Option<Verdict>,
+    /// Time of its last contact (any, side wall included), s.
     pub last_contact: Option<Real>,
     pub out_dir: PathBuf,
 }
 
 impl Outcome {
-    /// The residual velocity: the final speed if the projectile had left
-    /// contact at least [`FREE_FLIGHT`] before the end of the run (module doc).
+    /// The residual velocity: the speed along the flight at the end once
+    /// the axial force has vanished for [`FREE_FLIGHT`] with a plug cut out;
+    /// 0 if the plate held (module doc, [`crate::residual`]).
     pub fn residual(&self) -> Option<Real> {
-        let s = self.result.as_ref().ok()?;
-        match (self.final_speed, self.last_contact) {
-            (Some(v), Some(t)) if s.time - t >= FREE_FLIGHT => Some(v),
-            (Some(v), None) => Some(v),
-            _ => None,
-        }
+        self.result.as_ref().ok()?;
+        self.verdict?.residual()
     }
 
     /// \[RL10\]'s value for this row: its own model (plane strain, its
@@ -209,7 +205,8 @@ impl Outcome {
 }
 
 /// A row's run stops once a plug is cut out and the projectile has flown
-/// free of contact for this long, s (`time.stop_after_release`), unless
+/// free of force along its flight for this long (or has stopped for this
+/// long), s (`time.stop_after_release`, [`crate::residual`]), unless
 /// `plugsim validate --full-time`: its speed no longer changes, and the
 /// fine rows take a third of the time. Long enough for the plug, thrown
 /// ahead at the first impact, to be caught again (in the Borvik runs
@@ -229,14 +226,11 @@ pub fn run_row(row: &Row, out: &Path, full_time: bool) -> Outcome {
         execute(&case, &cfg, &mut |_| {}).map_err(|e: RunError| e.to_string())
     });
     let wall = t.elapsed().as_secs_f64();
-    let (final_speed, last_contact) = match &result {
-        Ok(s) => (
-            s.rigid_velocities.first().map(|(_, v)| (v[0] * v[0] + v[1] * v[1]).sqrt()),
-            s.last_contacts.first().and_then(|(_, t)| *t),
-        ),
+    let (verdict, last_contact) = match &result {
+        Ok(s) => (s.flights.first().map(|(_, v)| *v), s.last_contacts.first().and_then(|(_, t)| *t)),
         Err(_) => (None, None),
     };
-    Outcome { row: row.clone(), result, wall, final_speed, last_contact, out_dir: dir }
+    Outcome { row: row.clone(), result, wall, verdict, last_contact, out_dir: dir }
 }
 
 fn fmt_opt(v: Option<Real>, digits: usize) -> String {
@@ -274,7 +268,12 @@ pub fn table(outcomes: &[Outcome]) -> (String, String) {
         };
         let residual_md = match (&o.result, residual) {
             (Err(_), _) => format!("failed ({})", status.trim_start_matches("failed: ")),
-            (Ok(_), None) => format!("in contact at the end ({} m/s)", fmt_opt(o.final_speed, 1)),
+            (Ok(_), None) => match o.verdict {
+                Some(Verdict::Undecided { speed, free: true, .. }) => format!("free, no plug cut out ({speed:.1} m/s)"),
+                Some(Verdict::Undecided { speed, .. }) => format!("in contact at the end ({speed:.1} m/s)"),
+                _ => "—".to_string(),
+            },
+            (Ok(_), Some(_)) if matches!(o.verdict, Some(Verdict::Held { .. })) => "0 (held)".to_string(),
             (Ok(_), Some(v)) => format!("{v:.1}"),
         };
         let paper_perforation = r.experiment.perforation_time * 1e6;
@@ -401,11 +400,13 @@ pub fn report(header: &str, outcomes: &[Outcome], velocity_plots: &[String]) -> 
 }
 
 /// How the columns are measured (printed under the table).
-pub const METHODS: &str = "Residual velocity: the projectile's speed at the end of the run, once it \
-has flown free of contact (no slave particle pushing on it in `history.csv`) for at least 1 µs; \
-\"in contact at the end\" otherwise. Perforation: the first time the cracks cut a plug out of the \
-plate. Each run stops 20 µs after the projectile's last contact once the plug is cut out \
-(`--full-time`: at the paper's simulated time). Plug: the particles the through-cracks separate from the clamped plate (a flood fill over \
+pub const METHODS: &str = "Residual velocity: the projectile's speed along its flight direction (that \
+of its initial velocity) at the end of the run, once a plug is cut out and the contact force along \
+that direction (`projectile_f_axial` in `history.csv`) has stayed below 0.1 % of its peak for at \
+least 1 µs; a touch on the side wall of the hole pushes across the flight and does not count. A \
+projectile that stopped or bounced back reports 0 (held); \"in contact at the end\" otherwise. \
+Perforation: the first time the cracks cut a plug out of the plate. Each run stops 20 µs after the \
+projectile's release so defined, or 20 µs after it stopped (`--full-time`: at the paper's simulated time). Plug: the particles the through-cracks separate from the clamped plate (a flood fill over \
 the particles that the cracks do not separate), its mass (g; g per mm of depth in plane strain) \
 and mass-averaged velocity along the impact direction at the end of the run. Exposed contacts: \
 when particles that started in the interior, and joined the contact slaves once the projectile came \

@@ -592,8 +592,9 @@ fn fracture_section_is_validated() {
 }
 
 /// `time.stop_after_release`: a run that perforates ends once the
-/// projectile has been free of contact for that long, not at `time.end`;
-/// without a plug it runs to the end.
+/// projectile has been free of force along its flight for that long (and
+/// the plug cut out as long), not at `time.end`;
+/// without a plug (and not stopped) it runs to the end.
 #[test]
 fn run_stops_after_the_projectile_is_released() {
     use plugsim::run::{execute, RunConfig, RunInfo};
@@ -605,12 +606,16 @@ fn run_stops_after_the_projectile_is_released() {
     let cfg = RunConfig::new(dir.clone(), true, RunInfo::current("test", &[]));
     let s = execute(&case, &cfg, &mut |_| {}).unwrap();
     let perforated = s.perforation.expect("the small plate is perforated");
-    let last = s.last_contacts[0].1.expect("the projectile touched the plate");
+    let released = match s.flights[0].1 {
+        plugsim::residual::Verdict::Perforated { since, .. } => since,
+        v => panic!("the projectile flies free after perforating: {v:?}"),
+    };
     assert!(s.time < 4e-5, "stopped early: {} s", s.time);
-    // the wait counts from the later of perforation and the last contact
-    // (the history's last contact row is within a history interval of it)
-    let from = last.max(perforated);
-    assert!(s.time >= from + wait && s.time <= from + wait + 20.0 * s.dt, "{} {last} {perforated}", s.time);
+    // the wait counts from the later of perforation and the release (the
+    // axial force's vanishing; the history's last loaded row is within a
+    // history interval of it)
+    let from = released.max(perforated);
+    assert!(s.time >= from + wait && s.time <= from + wait + 20.0 * s.dt, "{} {released} {perforated}", s.time);
     // a negative wait is rejected, naming the field
     let bad = Case::from_str_with(SMALL_IMPACT, "small", &["time.stop_after_release=-1e-6".to_string()]);
     assert!(bad.is_err_and(|e| e.to_string().contains("time.stop_after_release")));

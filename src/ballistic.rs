@@ -1,0 +1,844 @@
+//! `plugsim ballistic`: a case with a rigid projectile run at several impact
+//! speeds, side by side, and its ballistic limit found by bisection; the
+//! `v_i → v_r` table, the Recht–Ipson fit and its plot (SPEC §10).
+//!
+//! - **Impact speed**: the projectile's initial velocity keeps its direction
+//!   and takes the given magnitude. The projectile is the case's one rigid
+//!   body with a non-zero initial velocity, or the one named.
+//! - **Outcome** of a run ([`crate::residual`]): *perforated* (a plug cut
+//!   out and the force along the flight vanished: `v_r` its speed along the
+//!   flight at the end), *held* (stopped or bounced back: `v_r = 0`), or
+//!   undecided at the end of the run. For the search an undecided run counts
+//!   as perforating if a plug has been cut out (the projectile is still
+//!   pushing it), else as held; the table says which runs were undecided.
+//!   Runs stop early by `time.stop_after_release` ([`STOP_AFTER`]).
+//! - **Ballistic limit** `v_bl`: between the highest speed the plate held
+//!   and the lowest that perforated it. The search first checks the bracket
+//!   (`lo` must hold, `hi` perforate; otherwise it moves `lo` down to half
+//!   or `hi` up by half, up to [`WIDEN_TRIES`] times each, running `jobs`
+//!   speeds spread over the new part of the range at once), then each round
+//!   runs `jobs` speeds evenly spaced inside the bracket at once (two jobs
+//!   split it in three) and keeps the sub-bracket where the outcome changes,
+//!   until it is at most `2·tol` wide; `v_bl` is its middle, `± tol`.
+//! - **Recht–Ipson**: `v_r = a (v_iᵖ − v_blᵖ)^(1/p)` fitted by least squares
+//!   to the perforating points ([`fit_recht_ipson`]), `v_bl` kept inside the
+//!   bracket.
+//!
+//! Runs go side by side on threads of their own, each with its own pool of
+//! worker threads (the solver's results do not depend on the thread count).
+//! The table is rewritten after every finished run, so an interrupt keeps
+//! every run finished before it. The library never prints: progress goes
+//! to a callback.
+
+use crate::case::Case;
+use crate::io::{IoError, LinePlot, PlotError, Series};
+use crate::math::{Real, Vec2};
+use crate::residual::Verdict;
+use crate::run::{execute, Progress, RunConfig, RunError, RunInfo};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{mpsc, Arc, Mutex};
+
+/// `time.stop_after_release` of every run, s, unless the case sets one:
+/// long enough for a plug thrown ahead to be caught again (as
+/// [`crate::validation::RELEASE_WAIT`]).
+pub const STOP_AFTER: Real = 20.0e-6;
+
+/// How many times the search moves a bound that does not bracket the limit.
+pub const WIDEN_TRIES: usize = 3;
+
+/// Why a ballistic study cannot start or stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum BallisticError {
+    #[error("case {case} has no rigid body with an initial velocity to use as the projectile (rigid bodies: {})", list(.bodies))]
+    NoProjectile { case: String, bodies: Vec<String> },
+    #[error("case {case} has several moving rigid bodies ({}); name the projectile with --projectile", list(.names))]
+    SeveralProjectiles { case: String, names: Vec<String> },
+    #[error("case {case} has no rigid body named '{name}' (rigid bodies: {})", list(.bodies))]
+    UnknownProjectile { case: String, name: String, bodies: Vec<String> },
+    #[error("rigid body '{name}' of case {case} is prescribed (it moves at its velocity whatever the forces): it has no residual velocity")]
+    Prescribed { case: String, name: String },
+    #[error("{0}")]
+    Settings(String),
+    #[error(transparent)]
+    Io(#[from] IoError),
+    #[error(transparent)]
+    Plot(#[from] PlotError),
+    #[error("experimental points {path}: {message}")]
+    Experiments { path: String, message: String },
+}
+
+fn list(names: &[String]) -> String {
+    if names.is_empty() {
+        "none".into()
+    } else {
+        names.join(", ")
+    }
+}
+
+/// What a study runs and where.
+#[derive(Clone, Debug)]
+pub struct Setup {
+    /// The case (with its `--set` overrides), unresolved.
+    pub case: Case,
+    /// Its name or file, for errors and the report.
+    pub label: String,
+    /// The `--set` overrides, for the report and each run's provenance.
+    pub overrides: Vec<String>,
+    /// Index of the projectile among the case's rigid bodies.
+    pub projectile: usize,
+    /// Runs at once.
+    pub jobs: usize,
+    /// Worker threads of each run.
+    pub threads_per_run: usize,
+    pub out_dir: PathBuf,
+    /// Set by Ctrl-C (or a test): runs in flight stop (each writes a
+    /// checkpoint), no new run starts, the finished ones are kept.
+    pub interrupt: Option<Arc<AtomicBool>>,
+}
+
+/// The projectile of `case`: the rigid body named `name`, else its only
+/// rigid body with a non-zero initial velocity.
+pub fn select_projectile(case: &Case, label: &str, name: Option<&str>) -> Result<usize, BallisticError> {
+    let bodies: Vec<String> = case.rigid_bodies.iter().map(|r| r.name.clone()).collect();
+    let index = match name {
+        Some(n) => bodies.iter().position(|b| b == n).ok_or_else(|| BallisticError::UnknownProjectile {
+            case: label.into(),
+            name: n.into(),
+            bodies: bodies.clone(),
+        })?,
+        None => {
+            let moving: Vec<usize> =
+                (0..bodies.len()).filter(|&k| case.rigid_bodies[k].velocity.iter().any(|&v| v != 0.0)).collect();
+            match moving.as_slice() {
+                [k] => *k,
+                [] => return Err(BallisticError::NoProjectile { case: label.into(), bodies }),
+                _ => {
+                    let names = moving.iter().map(|&k| bodies[k].clone()).collect();
+                    return Err(BallisticError::SeveralProjectiles { case: label.into(), names });
+                }
+            }
+        }
+    };
+    let spec = &case.rigid_bodies[index];
+    if spec.prescribed {
+        return Err(BallisticError::Prescribed { case: label.into(), name: spec.name.clone() });
+    }
+    if spec.velocity.iter().all(|&v| v == 0.0) {
+        return Err(BallisticError::NoProjectile { case: label.into(), bodies });
+    }
+    Ok(index)
+}
+
+/// The projectile's flight direction (unit) and the case's own impact
+/// speed, m/s.
+pub fn flight(case: &Case, projectile: usize) -> (Vec2, Real) {
+    let v = case.rigid_bodies[projectile].velocity;
+    let v = Vec2::new(v[0], v[1]);
+    (crate::residual::flight_direction(v), v.norm())
+}
+
+/// `case` with the projectile at `speed` m/s along its flight direction,
+/// stopping early by [`STOP_AFTER`] unless the case sets its own.
+pub fn at_speed(case: &Case, projectile: usize, speed: Real) -> Case {
+    let mut c = case.clone();
+    let (dir, _) = flight(case, projectile);
+    c.rigid_bodies[projectile].velocity = [dir.x * speed, dir.y * speed];
+    c.time.stop_after_release.get_or_insert(STOP_AFTER);
+    c
+}
+
+/// One run of the study.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Shot {
+    /// Impact speed, m/s.
+    pub speed: Real,
+    pub verdict: Verdict,
+    /// When the plug was first cut out, s.
+    pub perforation: Option<Real>,
+    /// Plug mass at the end, kg (kg per metre of depth in plane strain).
+    pub plug_mass: Option<Real>,
+    /// Simulated time at the end, s.
+    pub end_time: Real,
+    pub steps: u64,
+    /// Wall time, s.
+    pub wall: Real,
+    /// The run's directory.
+    pub dir: PathBuf,
+}
+
+impl Shot {
+    /// Whether the run counts as a perforation (module doc).
+    pub fn perforated(&self) -> bool {
+        match self.verdict {
+            Verdict::Perforated { .. } => true,
+            Verdict::Undecided { plug, .. } => plug,
+            _ => false,
+        }
+    }
+
+    /// Residual velocity, m/s: 0 when held, `None` when undecided.
+    pub fn residual(&self) -> Option<Real> {
+        self.verdict.residual()
+    }
+
+    /// The outcome in a word or two.
+    pub fn outcome(&self) -> String {
+        match self.verdict {
+            Verdict::Perforated { .. } => "perforated".into(),
+            Verdict::Held { .. } => "held".into(),
+            Verdict::Undecided { speed, plug: true, .. } => {
+                format!("plug cut, in contact at the end ({speed:.1} m/s): counted perforated")
+            }
+            Verdict::Undecided { speed, .. } => format!("undecided at the end ({speed:.1} m/s): counted held"),
+            Verdict::NotMoving => "not moving".into(),
+        }
+    }
+}
+
+/// Progress reports to the caller.
+#[derive(Clone, Debug)]
+pub enum Event {
+    /// A search round (or the bracket check) is about to run these speeds.
+    Round { label: String, speeds: Vec<Real> },
+    /// A run started.
+    Started { speed: Real },
+    /// A run reached `time` of at most `end` (s), every 10 %.
+    Advanced { speed: Real, time: Real, end: Real },
+    /// A run finished; the table on disk includes it.
+    Finished { shot: Shot },
+    /// A run failed (the study goes on without it).
+    Failed { speed: Real, message: String },
+    /// A run stopped by the interrupt (its checkpoint is in its directory).
+    Interrupted { speed: Real },
+}
+
+/// What a study found.
+#[derive(Clone, Debug, Default)]
+pub struct Study {
+    /// Finished runs, by speed.
+    pub shots: Vec<Shot>,
+    /// Runs that failed: speed, error.
+    pub failures: Vec<(Real, String)>,
+    /// Whether the interrupt stopped the study.
+    pub interrupted: bool,
+    /// The bisection's result, if it was asked for.
+    pub limit: Option<Limit>,
+    /// Recht–Ipson fit of the perforating points.
+    pub fit: Option<RechtIpson>,
+}
+
+/// The ballistic limit from the search.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Limit {
+    /// Highest speed held and lowest speed perforating (either may be
+    /// missing when the search could not bracket the limit), m/s.
+    pub held: Option<Real>,
+    pub perforated: Option<Real>,
+    /// The tolerance asked for, m/s.
+    pub tol: Real,
+    /// A held speed above the lowest perforating one (the outcome is not
+    /// monotonic in the speed there).
+    pub non_monotonic: Option<Real>,
+}
+
+impl Limit {
+    /// `v_bl` and its half-width, m/s, once bracketed.
+    pub fn estimate(&self) -> Option<(Real, Real)> {
+        let (lo, hi) = (self.held?, self.perforated?);
+        Some((0.5 * (lo + hi), 0.5 * (hi - lo)))
+    }
+}
+
+/// The Recht–Ipson curve `v_r = a (v_iᵖ − v_blᵖ)^(1/p)` (0 below `v_bl`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RechtIpson {
+    pub a: Real,
+    pub p: Real,
+    pub v_bl: Real,
+    /// Root-mean-square residual of the fit, m/s.
+    pub rms: Real,
+    /// Points fitted.
+    pub points: usize,
+    /// `p` held at 2 (fewer than three points).
+    pub p_fixed: bool,
+}
+
+impl RechtIpson {
+    /// `v_r` at impact speed `v_i`, m/s.
+    pub fn at(&self, v_i: Real) -> Real {
+        recht_ipson(v_i, self.a, self.p, self.v_bl)
+    }
+}
+
+fn recht_ipson(v_i: Real, a: Real, p: Real, v_bl: Real) -> Real {
+    if v_i <= v_bl {
+        0.0
+    } else {
+        a * (v_i.powf(p) - v_bl.powf(p)).powf(1.0 / p)
+    }
+}
+
+/// Range of the exponent `p` searched by [`fit_recht_ipson`].
+pub const P_RANGE: (Real, Real) = (1.0, 6.0);
+
+/// Least-squares Recht–Ipson fit to perforating points `(v_i, v_r)` (`v_r >
+/// 0`), with `v_bl` in `[v_min, min v_i]` (`v_min`: the highest speed the
+/// plate held, or 0). For given `p` and `v_bl` the best `a` is linear least
+/// squares, `a = Σ v_r g / Σ g²` with `g = (v_iᵖ − v_blᵖ)^(1/p)`; `p` (in
+/// [`P_RANGE`]) and `v_bl` are found on a 41 × 41 grid refined six times
+/// around its best point. With fewer than three points `p` is held at 2 (the
+/// classic rigid-plug value); with fewer than two there is no fit.
+pub fn fit_recht_ipson(points: &[(Real, Real)], v_min: Real) -> Option<RechtIpson> {
+    let pts: Vec<(Real, Real)> = points.iter().copied().filter(|p| p.1 > 0.0 && p.0 > 0.0).collect();
+    if pts.len() < 2 {
+        return None;
+    }
+    let v_max = pts.iter().map(|p| p.0).fold(Real::INFINITY, Real::min);
+    let v_min = v_min.clamp(0.0, v_max);
+    let p_fixed = pts.len() < 3;
+    let best_a = |p: Real, v_bl: Real| -> (Real, Real) {
+        let g: Vec<Real> = pts.iter().map(|q| recht_ipson(q.0, 1.0, p, v_bl)).collect();
+        let gg: Real = g.iter().map(|g| g * g).sum();
+        let a = if gg > 0.0 { pts.iter().zip(&g).map(|(q, g)| q.1 * g).sum::<Real>() / gg } else { 0.0 };
+        let sse = pts.iter().zip(&g).map(|(q, g)| (q.1 - a * g).powi(2)).sum();
+        (a, sse)
+    };
+    const N: usize = 41;
+    let (mut p_lo, mut p_hi) = if p_fixed { (2.0, 2.0) } else { P_RANGE };
+    let (mut b_lo, mut b_hi) = (v_min, v_max);
+    let mut best = (Real::INFINITY, 2.0, v_min, 0.0);
+    for _ in 0..7 {
+        for i in 0..N {
+            let p = p_lo + (p_hi - p_lo) * i as Real / (N - 1) as Real;
+            for j in 0..N {
+                let v_bl = b_lo + (b_hi - b_lo) * j as Real / (N - 1) as Real;
+                let (a, sse) = best_a(p, v_bl);
+                if sse < best.0 {
+                    best = (sse, p, v_bl, a);
+                }
+            }
+        }
+        let (dp, db) = (2.0 * (p_hi - p_lo) / (N - 1) as Real, 2.0 * (b_hi - b_lo) / (N - 1) as Real);
+        if !p_fixed {
+            (p_lo, p_hi) = ((best.1 - dp).max(P_RANGE.0), (best.1 + dp).min(P_RANGE.1));
+        }
+        (b_lo, b_hi) = ((best.2 - db).max(v_min), (best.2 + db).min(v_max));
+    }
+    let (sse, p, v_bl, a) = best;
+    Some(RechtIpson { a, p, v_bl, rms: (sse / pts.len() as Real).sqrt(), points: pts.len(), p_fixed })
+}
+
+/// Run every speed of `speeds` not run yet, `setup.jobs` at once, adding
+/// the finished runs to `study` (rewriting the table files after each).
+pub fn run_speeds(
+    setup: &Setup,
+    speeds: &[Real],
+    study: &mut Study,
+    report: &mut dyn FnMut(&Study) -> Result<(), BallisticError>,
+    progress: &mut dyn FnMut(Event),
+) -> Result<(), BallisticError> {
+    let todo: Vec<Real> = {
+        let mut v: Vec<Real> = Vec::new();
+        for &s in speeds {
+            if !study.shots.iter().any(|x| x.speed == s) && !v.contains(&s) {
+                v.push(s);
+            }
+        }
+        v
+    };
+    if todo.is_empty() || study.interrupted {
+        return Ok(());
+    }
+    let queue = Mutex::new(todo.into_iter().collect::<std::collections::VecDeque<Real>>());
+    let stop = setup.interrupt.clone().unwrap_or_else(|| Arc::new(AtomicBool::new(false)));
+    let (tx, rx) = mpsc::channel::<Event>();
+    let mut result = Ok(());
+    std::thread::scope(|scope| {
+        for _ in 0..setup.jobs.max(1) {
+            let (tx, queue, stop) = (tx.clone(), &queue, stop.clone());
+            scope.spawn(move || worker(setup, queue, &stop, &tx));
+        }
+        drop(tx);
+        for event in rx {
+            match &event {
+                Event::Finished { shot } => {
+                    study.shots.push(shot.clone());
+                    study.shots.sort_by(|a, b| a.speed.total_cmp(&b.speed));
+                    refit(study);
+                    if result.is_ok() {
+                        result = report(study);
+                    }
+                }
+                Event::Failed { speed, message } => study.failures.push((*speed, message.clone())),
+                Event::Interrupted { .. } => study.interrupted = true,
+                _ => {}
+            }
+            progress(event);
+        }
+    });
+    if stop.load(Ordering::SeqCst) {
+        study.interrupted = true;
+    }
+    result
+}
+
+/// One side-by-side slot: take speeds off the queue until it is empty or
+/// the study is interrupted, running each on this thread's own pool.
+fn worker(
+    setup: &Setup,
+    queue: &Mutex<std::collections::VecDeque<Real>>,
+    stop: &Arc<AtomicBool>,
+    tx: &mpsc::Sender<Event>,
+) {
+    let pool = match rayon::ThreadPoolBuilder::new().num_threads(setup.threads_per_run.max(1)).build() {
+        Ok(p) => p,
+        Err(e) => {
+            while let Some(speed) = queue.lock().map(|mut q| q.pop_front()).unwrap_or(None) {
+                let _ = tx.send(Event::Failed { speed, message: format!("cannot start worker threads: {e}") });
+            }
+            return;
+        }
+    };
+    loop {
+        if stop.load(Ordering::SeqCst) {
+            return;
+        }
+        let Some(speed) = queue.lock().map(|mut q| q.pop_front()).unwrap_or(None) else {
+            return;
+        };
+        let _ = tx.send(Event::Started { speed });
+        let event = pool.install(|| run_one(setup, speed, stop, tx));
+        let _ = tx.send(event);
+    }
+}
+
+/// Directory of the run at `speed` inside the study's directory.
+pub fn run_dir(out_dir: &Path, speed: Real) -> PathBuf {
+    out_dir.join(format!("v{speed:.2}"))
+}
+
+/// Run the case at `speed`; the event that ends it.
+fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender<Event>) -> Event {
+    let t = std::time::Instant::now();
+    let case = at_speed(&setup.case, setup.projectile, speed);
+    let dir = run_dir(&setup.out_dir, speed);
+    let mut overrides = setup.overrides.clone();
+    overrides.push(format!(
+        "rigid_bodies[{}].velocity = {:?}",
+        setup.projectile, case.rigid_bodies[setup.projectile].velocity
+    ));
+    let cfg = RunConfig {
+        interrupt: Some(stop.clone()),
+        ..RunConfig::new(dir.clone(), true, RunInfo::current(&setup.label, &overrides))
+    };
+    let mut next = 0.1;
+    let mut report = |p: Progress| {
+        if let Progress::Step { sim } = p {
+            let end = case.time.end;
+            if sim.time >= next * end {
+                next = (sim.time / end * 10.0).floor() / 10.0 + 0.1;
+                let _ = tx.send(Event::Advanced { speed, time: sim.time, end });
+            }
+        }
+    };
+    match execute(&case, &cfg, &mut report) {
+        Ok(s) => {
+            let name = &case.rigid_bodies[setup.projectile].name;
+            let verdict = s.flights.iter().find(|(n, _)| n == name).map_or(Verdict::NotMoving, |(_, v)| *v);
+            Event::Finished {
+                shot: Shot {
+                    speed,
+                    verdict,
+                    perforation: s.perforation,
+                    plug_mass: s.plug.as_ref().map(|p| p.mass),
+                    end_time: s.time,
+                    steps: s.steps,
+                    wall: t.elapsed().as_secs_f64(),
+                    dir,
+                },
+            }
+        }
+        Err(RunError::Interrupted { .. }) => Event::Interrupted { speed },
+        Err(e) => Event::Failed { speed, message: e.to_string() },
+    }
+}
+
+/// The bracket the finished runs give: the lowest perforating speed, the
+/// highest held speed below it, and a held speed above it if any.
+pub fn bracket(shots: &[Shot]) -> (Option<Real>, Option<Real>, Option<Real>) {
+    let hi = shots
+        .iter()
+        .filter(|s| s.perforated())
+        .map(|s| s.speed)
+        .fold(None, |m: Option<Real>, v| Some(m.map_or(v, |m| m.min(v))));
+    let below = |s: &&Shot| hi.is_none_or(|h| s.speed < h);
+    let lo = shots
+        .iter()
+        .filter(|s| !s.perforated())
+        .filter(below)
+        .map(|s| s.speed)
+        .fold(None, |m: Option<Real>, v| Some(m.map_or(v, |m| m.max(v))));
+    let above =
+        shots.iter().filter(|s| !s.perforated() && hi.is_some_and(|h| s.speed > h)).map(|s| s.speed).reduce(Real::max);
+    (lo, hi, above)
+}
+
+/// Find the ballistic limit between `lo` and `hi` to `± tol` m/s (module
+/// doc), using the runs already in `study` too.
+pub fn find_limit(
+    setup: &Setup,
+    (lo, hi): (Real, Real),
+    tol: Real,
+    study: &mut Study,
+    report: &mut dyn FnMut(&Study) -> Result<(), BallisticError>,
+    progress: &mut dyn FnMut(Event),
+) -> Result<(), BallisticError> {
+    if !(lo > 0.0 && hi > lo && tol > 0.0) {
+        return Err(BallisticError::Settings(format!(
+            "the search needs 0 < lo < hi and tol > 0 (lo = {lo}, hi = {hi}, tol = {tol})"
+        )));
+    }
+    let mut round = |label: String, speeds: Vec<Real>, study: &mut Study| -> Result<(), BallisticError> {
+        progress(Event::Round { label, speeds: speeds.clone() });
+        run_speeds(setup, &speeds, study, report, progress)
+    };
+    round("bracket".into(), vec![lo, hi], study)?;
+    let (mut lo, mut hi) = (lo, hi);
+    for _ in 0..WIDEN_TRIES {
+        if study.interrupted {
+            break;
+        }
+        let outcome = |v: Real, study: &Study| study.shots.iter().find(|s| s.speed == v).map(Shot::perforated);
+        // The `jobs` runs of a round spread over the new half of the range.
+        let n = setup.jobs.max(1);
+        let mut more = Vec::new();
+        if outcome(lo, study) == Some(true) {
+            more.extend((1..=n).map(|k| lo * (1.0 - 0.5 * k as Real / n as Real)));
+            lo *= 0.5;
+        }
+        if outcome(hi, study) == Some(false) {
+            more.extend((1..=n).map(|k| hi * (1.0 + 0.5 * k as Real / n as Real)));
+            hi *= 1.5;
+        }
+        let more = more.into_iter().map(|v| (v * 100.0).round() / 100.0).collect::<Vec<_>>();
+        let (lo_now, hi_now) = (lo, hi);
+        lo = more.iter().copied().filter(|&v| v <= lo_now * 1.000_001).fold(lo_now, Real::min);
+        hi = more.iter().copied().filter(|&v| v >= hi_now * 0.999_999).fold(hi_now, Real::max);
+        if more.is_empty() {
+            break;
+        }
+        round("widening the bracket".into(), more, study)?;
+    }
+    loop {
+        let (held, perforated, above) = bracket(&study.shots);
+        study.limit = Some(Limit { held, perforated, tol, non_monotonic: above });
+        let (Some(lo), Some(hi)) = (held, perforated) else {
+            break;
+        };
+        if hi - lo <= 2.0 * tol || study.interrupted {
+            break;
+        }
+        let n = setup.jobs.max(1);
+        let speeds = (1..=n)
+            .map(|k| lo + (hi - lo) * k as Real / (n + 1) as Real)
+            .map(|v| (v * 100.0).round() / 100.0)
+            .collect();
+        round(format!("bracket {lo:.2}–{hi:.2} m/s"), speeds, study)?;
+        if study.shots.len() + study.failures.len() > 200 {
+            break;
+        }
+    }
+    Ok(())
+}
+
+/// Refit Recht–Ipson to the perforating runs of `study`, with `v_bl` above
+/// the highest held speed below them.
+pub fn refit(study: &mut Study) {
+    let (held, _, _) = bracket(&study.shots);
+    let points: Vec<(Real, Real)> = study
+        .shots
+        .iter()
+        .filter_map(|s| match s.verdict {
+            Verdict::Perforated { residual, .. } if residual > 0.0 => Some((s.speed, residual)),
+            _ => None,
+        })
+        .collect();
+    study.fit = fit_recht_ipson(&points, held.unwrap_or(0.0));
+}
+
+/// Experimental points `(v_i, v_r)` from a CSV file with header `v_i,v_r`
+/// (m/s; `#` starts a comment; `v_r = 0`: the plate held).
+pub fn read_experiments(path: &Path) -> Result<Vec<(Real, Real)>, BallisticError> {
+    let err = |message: String| BallisticError::Experiments { path: path.display().to_string(), message };
+    let text = std::fs::read_to_string(path).map_err(|e| err(e.to_string()))?;
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .map(|(k, l)| (k + 1, l.split('#').next().unwrap_or("").trim()))
+        .filter(|(_, l)| !l.is_empty());
+    match lines.next() {
+        Some((_, h)) if h.replace(' ', "") == "v_i,v_r" => {}
+        other => {
+            return Err(err(format!("the first line must be the header `v_i,v_r`, found {:?}", other.map(|o| o.1))))
+        }
+    }
+    lines
+        .map(|(k, l)| {
+            let v: Vec<Real> = l
+                .split(',')
+                .map(|x| x.trim().parse::<Real>())
+                .collect::<Result<_, _>>()
+                .map_err(|e| err(format!("line {k}: {e}")))?;
+            match v.as_slice() {
+                [a, b] if *a > 0.0 && *b >= 0.0 => Ok((*a, *b)),
+                _ => Err(err(format!("line {k}: expected two numbers v_i > 0, v_r >= 0"))),
+            }
+        })
+        .collect()
+}
+
+/// The table as (Markdown, CSV).
+pub fn table(study: &Study) -> (String, String) {
+    let mut md = String::from("| v_i (m/s) | v_r (m/s) | outcome | perforation (us) | plug mass (kg; kg/m in plane strain) | end (us) | steps | wall (s) |\n|---|---|---|---|---|---|---|---|\n");
+    let mut csv = String::from("v_i_m_s,v_r_m_s,perforated,outcome,perforation_us,plug_mass,end_us,steps,wall_s,dir\n");
+    let opt = |v: Option<Real>, f: &dyn Fn(Real) -> String| v.map_or_else(String::new, f);
+    for s in &study.shots {
+        let vr = opt(s.residual(), &|v| format!("{v:.2}"));
+        let perf = opt(s.perforation, &|t| format!("{:.2}", t * 1e6));
+        let mass = opt(s.plug_mass, &|m| format!("{m:.5}"));
+        md.push_str(&format!(
+            "| {:.2} | {} | {} | {} | {} | {:.1} | {} | {:.1} |\n",
+            s.speed,
+            if vr.is_empty() { "—".into() } else { vr.clone() },
+            s.outcome(),
+            if perf.is_empty() { "—".into() } else { perf.clone() },
+            if mass.is_empty() { "—".into() } else { mass.clone() },
+            s.end_time * 1e6,
+            s.steps,
+            s.wall
+        ));
+        csv.push_str(&format!(
+            "{:.2},{vr},{},{},{perf},{mass},{:.3},{},{:.2},{}\n",
+            s.speed,
+            s.perforated(),
+            s.outcome().replace(',', ";"),
+            s.end_time * 1e6,
+            s.steps,
+            s.wall,
+            s.dir.display()
+        ));
+    }
+    for (v, e) in &study.failures {
+        md.push_str(&format!(
+            "| {v:.2} | — | failed: {} | | | | | |\n",
+            e.lines().next().unwrap_or("").replace('|', "/")
+        ));
+    }
+    (md, csv)
+}
+
+/// How the outcome is read (printed in the report).
+pub const DEFINITIONS: &str = "Residual velocity v_r: the projectile's speed along its flight direction (that \
+of its initial velocity) at the end of the run, once a plug has been cut out and the contact force along \
+that direction (`NAME_f_axial` in each run's `history.csv`) has stayed below 0.1 % of its peak for at least \
+1 us; a touch on the side wall of the hole pushes across the flight and does not count. Held: the \
+projectile's speed along its flight fell to 1 % of the impact speed or below (stopped or bounced back): \
+v_r = 0. Each run stops 20 us after either (`time.stop_after_release`), or at the case's end time. A run \
+still undecided at its end counts as perforating if a plug was cut out, else as held. Ballistic limit: \
+between the highest speed held and the lowest perforating; each search round runs as many speeds as run \
+side by side, evenly spaced inside the bracket. Recht-Ipson: v_r = a (v_i^p - v_bl^p)^(1/p), least squares \
+over the perforating runs with v_bl between the highest held speed and the lowest perforating one (p = 2 \
+with fewer than three points).";
+
+/// The Markdown report: `header` (case, settings, provenance), the table,
+/// the limit, the fit, the definitions and the plot.
+pub fn report(header: &str, study: &Study) -> String {
+    let (md, _) = table(study);
+    let mut s = format!("# Ballistic study\n\n{header}\n\n{md}\n");
+    if study.interrupted {
+        s.push_str("**Interrupted**: the table holds the runs finished before the interrupt.\n\n");
+    }
+    if let Some(l) = &study.limit {
+        match (l.estimate(), l.held, l.perforated) {
+            (Some((v, h)), _, _) => s.push_str(&format!(
+                "Ballistic limit: **v_bl = {v:.2} ± {h:.2} m/s** (held at {:.2}, perforated at {:.2} m/s; tolerance ±{} m/s{}).\n\n",
+                l.held.unwrap_or(0.0),
+                l.perforated.unwrap_or(0.0),
+                l.tol,
+                if h > l.tol { ", not reached" } else { "" }
+            )),
+            (None, Some(lo), None) => s.push_str(&format!("Ballistic limit not bracketed: every speed held, up to {lo:.2} m/s.\n\n")),
+            (None, None, Some(hi)) => s.push_str(&format!("Ballistic limit not bracketed: every speed perforated, down to {hi:.2} m/s.\n\n")),
+            _ => s.push_str("Ballistic limit: no finished runs.\n\n"),
+        }
+        let undecided = study
+            .shots
+            .iter()
+            .find(|x| Some(x.speed) == l.held)
+            .filter(|x| matches!(x.verdict, Verdict::Undecided { .. }));
+        if let Some(x) = undecided {
+            s.push_str(&format!(
+                "Warning: the held side of the bracket ({:.2} m/s) is a run still moving along its flight at its end \
+                 ({:.1} us) without a plug cut out: this is the limit of perforation within that time; raise \
+                 `time.end` (`--set time.end=...`) for the physical limit.\n\n",
+                x.speed,
+                x.end_time * 1e6
+            ));
+        }
+        if let Some(v) = l.non_monotonic {
+            s.push_str(&format!("Note: the plate held at {v:.2} m/s, above the lowest perforating speed.\n\n"));
+        }
+    }
+    match &study.fit {
+        Some(f) => s.push_str(&format!(
+            "Recht–Ipson fit over {} perforating runs: a = {:.4}, p = {:.3}{}, v_bl = {:.2} m/s (rms residual {:.2} m/s).\n\n",
+            f.points,
+            f.a,
+            f.p,
+            if f.p_fixed { " (held)" } else { "" },
+            f.v_bl,
+            f.rms
+        )),
+        None => s.push_str("Recht–Ipson fit: fewer than two perforating runs.\n\n"),
+    }
+    s.push_str(&format!("{DEFINITIONS}\n\n![v_r against v_i](ballistic.png)\n"));
+    s
+}
+
+/// The `v_r(v_i)` plot: the runs as points, the fit as a curve, the
+/// experimental points if any.
+pub fn plot(study: &Study, title: &str, experiments: &[(Real, Real)]) -> LinePlot {
+    // Points apart: a lone point between non-finite ones is drawn as a dot.
+    let dots =
+        |p: &mut dyn Iterator<Item = (Real, Real)>| p.flat_map(|q| [q, (Real::NAN, Real::NAN)]).collect::<Vec<_>>();
+    let mut series = vec![Series {
+        name: "simulated".into(),
+        points: dots(&mut study.shots.iter().filter_map(|s| s.residual().map(|v| (s.speed, v)))),
+    }];
+    if let Some(f) = &study.fit {
+        let v_max = study
+            .shots
+            .iter()
+            .map(|s| s.speed)
+            .fold(f.v_bl, Real::max)
+            .max(experiments.iter().map(|e| e.0).fold(0.0, Real::max));
+        let v_min = (0.8 * f.v_bl).min(study.shots.iter().map(|s| s.speed).fold(f.v_bl, Real::min));
+        let points = (0..=200).map(|k| v_min + (v_max - v_min) * k as Real / 200.0).map(|v| (v, f.at(v))).collect();
+        series.push(Series {
+            name: format!("Recht-Ipson a = {:.3}, p = {:.2}, v_bl = {:.1} m/s", f.a, f.p, f.v_bl),
+            points,
+        });
+    }
+    if !experiments.is_empty() {
+        series.push(Series { name: "experiments".into(), points: dots(&mut experiments.iter().copied()) });
+    }
+    LinePlot {
+        title: title.to_string(),
+        x_label: "impact velocity v_i (m/s)".into(),
+        y_label: "residual velocity v_r (m/s)".into(),
+        series,
+        hlines: vec![],
+    }
+}
+
+/// Write `ballistic.csv`, `ballistic.md` and `ballistic.png` into `dir`.
+pub fn write_files(
+    dir: &Path,
+    header: &str,
+    title: &str,
+    study: &Study,
+    experiments: &[(Real, Real)],
+) -> Result<Vec<PathBuf>, BallisticError> {
+    let (_, csv) = table(study);
+    let write = |name: &str, text: String| -> Result<PathBuf, BallisticError> {
+        let path = dir.join(name);
+        std::fs::write(&path, text).map_err(|source| IoError::Write { path: path.clone(), source })?;
+        Ok(path)
+    };
+    let mut files = vec![write("ballistic.csv", csv)?, write("ballistic.md", report(header, study))?];
+    let png = dir.join("ballistic.png");
+    crate::io::save_line_plot(&png, &plot(study, title, experiments))?;
+    files.push(png);
+    Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn synthetic(a: Real, p: Real, v_bl: Real, speeds: &[Real]) -> Vec<(Real, Real)> {
+        speeds.iter().map(|&v| (v, recht_ipson(v, a, p, v_bl))).collect()
+    }
+
+    #[test]
+    fn the_fit_recovers_known_parameters() {
+        let speeds = [190.0, 200.0, 220.0, 250.0, 280.0, 320.0];
+        let f = fit_recht_ipson(&synthetic(0.8, 2.5, 180.0, &speeds), 170.0).unwrap();
+        assert!((f.a - 0.8).abs() < 2e-3 && (f.p - 2.5).abs() < 2e-2 && (f.v_bl - 180.0).abs() < 0.2, "{f:?}");
+        assert!(f.rms < 0.05 && !f.p_fixed && f.points == 6, "{f:?}");
+        // The classic rigid-plug curve, a = 1, p = 2.
+        let f = fit_recht_ipson(&synthetic(1.0, 2.0, 150.0, &speeds), 0.0).unwrap();
+        assert!((f.a - 1.0).abs() < 1e-3 && (f.p - 2.0).abs() < 1e-2 && (f.v_bl - 150.0).abs() < 0.2, "{f:?}");
+        // Noisy points: still close.
+        let noisy: Vec<(Real, Real)> = synthetic(0.9, 2.0, 160.0, &speeds)
+            .iter()
+            .enumerate()
+            .map(|(k, p)| (p.0, p.1 + [0.5, -0.5][k % 2]))
+            .collect();
+        let f = fit_recht_ipson(&noisy, 0.0).unwrap();
+        assert!((f.v_bl - 160.0).abs() < 10.0 && (f.a - 0.9).abs() < 0.05 && f.rms < 1.0, "{f:?}");
+    }
+
+    #[test]
+    fn the_fit_keeps_v_bl_in_the_bracket_and_needs_points() {
+        // Held at 185 m/s: v_bl may not be below it, even if the points say 180.
+        let pts = synthetic(0.8, 2.5, 180.0, &[190.0, 220.0, 260.0, 300.0]);
+        let f = fit_recht_ipson(&pts, 185.0).unwrap();
+        assert!(f.v_bl >= 185.0 && f.v_bl <= 190.0, "{f:?}");
+        // Two points: p held at 2, the curve through both.
+        let f = fit_recht_ipson(&synthetic(0.7, 2.0, 100.0, &[150.0, 250.0]), 0.0).unwrap();
+        assert!(f.p_fixed && f.p == 2.0 && (f.v_bl - 100.0).abs() < 0.1 && f.rms < 1e-2, "{f:?}");
+        assert_eq!(fit_recht_ipson(&[(200.0, 100.0), (150.0, 0.0)], 0.0), None);
+    }
+
+    fn shot(speed: Real, verdict: Verdict) -> Shot {
+        Shot {
+            speed,
+            verdict,
+            perforation: None,
+            plug_mass: None,
+            end_time: 0.0,
+            steps: 0,
+            wall: 0.0,
+            dir: PathBuf::new(),
+        }
+    }
+
+    #[test]
+    fn the_bracket_is_the_highest_hold_below_the_lowest_perforation() {
+        let held = Verdict::Held { since: 0.0 };
+        let perf = |v| Verdict::Perforated { residual: v, since: 0.0 };
+        let shots = vec![shot(100.0, held), shot(150.0, held), shot(200.0, perf(50.0)), shot(300.0, perf(200.0))];
+        assert_eq!(bracket(&shots), (Some(150.0), Some(200.0), None));
+        let pushing = Verdict::Undecided { speed: 20.0, plug: true, free: false };
+        let shots = vec![shot(150.0, held), shot(170.0, pushing), shot(180.0, held)];
+        assert_eq!(bracket(&shots), (Some(150.0), Some(170.0), Some(180.0)));
+        let limit = Limit { held: Some(150.0), perforated: Some(170.0), tol: 1.0, non_monotonic: None };
+        assert_eq!(limit.estimate(), Some((160.0, 10.0)));
+    }
+
+    #[test]
+    fn experimental_points_need_their_header() {
+        let dir = std::env::temp_dir().join(format!("plugsim-experiments-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("e.csv");
+        std::fs::write(&path, "# source\nv_i,v_r\n200.0, 100.5\n150,0 # held\n").unwrap();
+        assert_eq!(read_experiments(&path).unwrap(), vec![(200.0, 100.5), (150.0, 0.0)]);
+        std::fs::write(&path, "200,100\n").unwrap();
+        assert!(read_experiments(&path).unwrap_err().to_string().contains("header"));
+        std::fs::write(&path, "v_i,v_r\n200,x\n").unwrap();
+        assert!(read_experiments(&path).unwrap_err().to_string().contains("line 2"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

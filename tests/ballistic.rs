@@ -1,0 +1,165 @@
+//! `plugsim ballistic` end to end on a small plate, and the residual
+//! velocity every run reports (`plugsim::residual`).
+
+use plugsim::ballistic::{find_limit, run_speeds, select_projectile, write_files, Event, Setup, Study};
+use plugsim::case::Case;
+use plugsim::residual::Verdict;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+/// A 4 mm plate, 24 mm wide, and a blunt 8 mm projectile (as the fracture
+/// tests' small impact): seconds per run.
+const SMALL_PLATE: &str = r#"
+title = "small plate, blunt projectile"
+[geometry]
+mode = "plane_strain"
+[[bodies]]
+name = "plate"
+material = "weldox_460e"
+[bodies.rectangle]
+x_min = -0.012
+x_max = 0.012
+y_min = 0.0
+y_max = 0.004
+layers = 9
+[[bodies.supports]]
+region = { x_min = -0.012, x_max = -0.011, y_min = 0.0, y_max = 0.004 }
+[[bodies.supports]]
+region = { x_min = 0.011, x_max = 0.012, y_min = 0.0, y_max = 0.004 }
+[[rigid_bodies]]
+name = "projectile"
+rectangle = { center = [0.0, 0.01405], width = 0.008, height = 0.02 }
+density = 7850.0
+velocity = [0.0, -400.0]
+[fracture]
+criterion = "effective_strain"
+[time]
+end = 100.0e-6
+stop_after_release = 2.0e-6
+[output]
+interval = 1.0e-5
+"#;
+
+fn setup(name: &str, jobs: usize) -> Setup {
+    let case = Case::from_str_with(SMALL_PLATE, "small", &[]).unwrap();
+    let projectile = select_projectile(&case, "small", None).unwrap();
+    let out_dir = std::env::temp_dir().join(format!("plugsim-ballistic-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out_dir);
+    std::fs::create_dir_all(&out_dir).unwrap();
+    Setup {
+        case,
+        label: "small".into(),
+        overrides: vec![],
+        projectile,
+        jobs,
+        threads_per_run: 1,
+        out_dir,
+        interrupt: None,
+    }
+}
+
+/// The history has the axial force; a run that perforates reports its
+/// residual velocity along the flight once that force has vanished, even
+/// while the hole's wall still touches the projectile's side.
+#[test]
+fn a_perforating_run_reports_its_residual_velocity() {
+    use plugsim::run::{execute, RunConfig, RunInfo};
+    let s = setup("single", 1);
+    let cfg = RunConfig::new(s.out_dir.join("run"), true, RunInfo::current("test", &[]));
+    let summary = execute(&s.case, &cfg, &mut |_| {}).unwrap();
+    let history = plugsim::output::read_history(&cfg.out_dir).unwrap();
+    let f = history.column("projectile_f_axial").expect("the axial force column");
+    let fy = history.column("projectile_fy").unwrap();
+    // Flight along -y: the axial force is -fy.
+    assert!(f.iter().zip(fy).all(|(a, b)| (a + b).abs() <= 1e-9 * b.abs().max(1.0)));
+    assert!(f.iter().any(|&f| f < 0.0), "braked along its flight");
+    let (name, verdict) = &summary.flights[0];
+    assert_eq!(name, "projectile");
+    let Verdict::Perforated { residual, since } = *verdict else { panic!("{verdict:?}") };
+    let vy = summary.rigid_velocities[0].1[1];
+    assert_eq!(residual, -vy);
+    assert!(residual > 0.0 && residual < 400.0, "{residual}");
+    assert!(summary.time < 100e-6 && summary.time >= since + 2e-6, "stopped early: {} s", summary.time);
+    std::fs::remove_dir_all(&s.out_dir).ok();
+}
+
+#[test]
+fn a_case_without_a_moving_rigid_body_is_refused_by_name() {
+    let text = SMALL_PLATE.replace("velocity = [0.0, -400.0]", "velocity = [0.0, 0.0]");
+    let case = Case::from_str_with(&text, "still", &[]).unwrap();
+    let e = select_projectile(&case, "still.toml", None).unwrap_err().to_string();
+    assert!(e.contains("still.toml") && e.contains("no rigid body with an initial velocity"), "{e}");
+    let e = select_projectile(&case, "still.toml", Some("bullet")).unwrap_err().to_string();
+    assert!(e.contains("no rigid body named 'bullet'") && e.contains("projectile"), "{e}");
+    let plain = Case::from_str_with(include_str!("../cases/elastic-strike.toml"), "elastic-strike", &[]).unwrap();
+    let e = select_projectile(&plain, "elastic-strike", None).unwrap_err().to_string();
+    assert!(e.contains("elastic-strike") && e.contains("(rigid bodies: none)"), "{e}");
+}
+
+#[test]
+fn speeds_run_side_by_side_and_the_limit_is_bracketed() {
+    let s = setup("limit", 2);
+    let mut study = Study::default();
+    let mut events = Vec::new();
+    let mut writes = 0;
+    let mut report = |st: &Study| {
+        writes += 1;
+        write_files(&s.out_dir, "test", "test", st, &[(300.0, 200.0)]).map(|_| ())
+    };
+    run_speeds(&s, &[300.0, 500.0], &mut study, &mut report, &mut |e| events.push(e)).unwrap();
+    assert_eq!(study.shots.len(), 2, "{:?}", study.failures);
+    let (slow, fast) = (&study.shots[0], &study.shots[1]);
+    assert!(slow.perforated() && fast.perforated(), "{:?} {:?}", slow.verdict, fast.verdict);
+    assert!(fast.residual().unwrap() > slow.residual().unwrap(), "{:?} {:?}", slow.verdict, fast.verdict);
+    assert!(slow.plug_mass.unwrap() > 0.0 && slow.perforation.is_some());
+    find_limit(&s, (50.0, 300.0), 25.0, &mut study, &mut report, &mut |e| events.push(e)).unwrap();
+    let limit = study.limit.clone().unwrap();
+    let (v_bl, half) = limit.estimate().expect("bracketed");
+    assert!(half <= 25.0 && v_bl > 50.0 && v_bl < 300.0, "{limit:?}");
+    let held = study.shots.iter().find(|x| x.speed == limit.held.unwrap()).unwrap();
+    // Held, or undecided at the end without a plug cut out (counted held).
+    assert!(
+        held.residual() == Some(0.0) || matches!(held.verdict, Verdict::Undecided { plug: false, .. }),
+        "{:?}",
+        held.verdict
+    );
+    // Each held run is below each perforating one, and v_r rises with v_i.
+    let perforating: Vec<_> = study.shots.iter().filter(|x| x.perforated()).collect();
+    assert!(perforating.windows(2).all(|w| w[1].residual() >= w[0].residual()), "{:?}", study.shots);
+    assert_eq!(writes, study.shots.len(), "the table is written after every run");
+    let csv = std::fs::read_to_string(s.out_dir.join("ballistic.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + study.shots.len(), "{csv}");
+    for f in ["ballistic.md", "ballistic.png"] {
+        assert!(s.out_dir.join(f).exists(), "{f}");
+    }
+    assert!(study.shots.iter().all(|x| x.dir.join("history.csv").exists()));
+    assert!(events.iter().any(|e| matches!(e, Event::Round { .. })));
+    std::fs::remove_dir_all(&s.out_dir).ok();
+}
+
+/// An interrupt after the first run keeps that run in the table and stops
+/// the rest.
+#[test]
+fn an_interrupt_keeps_the_finished_runs() {
+    let mut s = setup("interrupt", 1);
+    let flag = Arc::new(AtomicBool::new(false));
+    s.interrupt = Some(flag.clone());
+    let mut study = Study::default();
+    let mut report = |st: &Study| write_files(&s.out_dir, "test", "test", st, &[]).map(|_| ());
+    let mut progress = |e: Event| {
+        if matches!(e, Event::Finished { .. }) {
+            flag.store(true, Ordering::SeqCst);
+        }
+    };
+    run_speeds(&s, &[450.0, 350.0, 250.0], &mut study, &mut report, &mut progress).unwrap();
+    assert!(study.interrupted);
+    assert_eq!(study.shots.len(), 1);
+    assert_eq!(study.shots[0].speed, 450.0);
+    let csv = std::fs::read_to_string(s.out_dir.join("ballistic.csv")).unwrap();
+    assert!(csv.lines().nth(1).unwrap().starts_with("450.00,"), "{csv}");
+    assert_eq!(csv.lines().count(), 2);
+    // A study already interrupted runs nothing more.
+    run_speeds(&s, &[250.0], &mut study, &mut report, &mut |_| {}).unwrap();
+    assert_eq!(study.shots.len(), 1);
+    std::fs::remove_dir_all(&s.out_dir).ok();
+}
