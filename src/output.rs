@@ -633,13 +633,16 @@ pub fn plot_history(dir: &Path) -> Result<Vec<PathBuf>, OutputError> {
 pub fn field_plot(sim: &Simulation, field: &str, window: Option<[Real; 4]>) -> Option<crate::io::FieldPlot> {
     let m = &sim.model;
     let q = &m.quad;
-    let (values, label): (Vec<Real>, &str) = match field {
-        "effective_stress" => {
-            (m.project(|k| von_mises(&(q.tau[k].to_tensor() / q.f[k].determinant())) * 1e-6), "effective stress (MPa)")
-        }
-        "temperature" => (m.project(|k| q.temperature[k]), "temperature (K)"),
-        "plastic_strain" => (m.project(|k| q.eps_p[k]), "effective plastic strain"),
-        "damage" => (m.project(|k| q.damage[k]), "Johnson-Cook damage"),
+    // (values, label, physical lower bound of the colour scale)
+    let (values, label, floor): (Vec<Real>, &str, Option<Real>) = match field {
+        "effective_stress" => (
+            m.project(|k| von_mises(&(q.tau[k].to_tensor() / q.f[k].determinant())) * 1e-6),
+            "effective stress (MPa)",
+            Some(0.0),
+        ),
+        "temperature" => (m.project(|k| q.temperature[k]), "temperature (K)", None),
+        "plastic_strain" => (m.project(|k| q.eps_p[k]), "effective plastic strain", Some(0.0)),
+        "damage" => (m.project(|k| q.damage[k]), "Johnson-Cook damage", Some(0.0)),
         _ => return None,
     };
     let u = m.physical(&m.particles.u);
@@ -654,7 +657,12 @@ pub fn field_plot(sim: &Simulation, field: &str, window: Option<[Real; 4]>) -> O
         .map(|c| {
             c.cracks
                 .iter()
-                .flat_map(|k| k.face_polylines(m))
+                .flat_map(|k| {
+                    let reference: Vec<Vec2> = k.vertices.iter().map(|v| v.x0).collect();
+                    k.face_polylines(m)
+                        .into_iter()
+                        .flat_map(move |face| clip_stretched(&reference, &face, MAX_DRAWN_STRETCH))
+                })
                 .map(|l| l.iter().map(|p| (p.x * 1e3, p.y * 1e3)).collect())
                 .collect()
         })
@@ -669,8 +677,35 @@ pub fn field_plot(sim: &Simulation, field: &str, window: Option<[Real; 4]>) -> O
             .collect(),
         values: idx.iter().map(|&i| values[i]).collect(),
         value_label: label.into(),
+        value_floor: floor,
         lines,
     })
+}
+
+/// Longest a crack-face segment is drawn, as a multiple of its length in
+/// the reference configuration: a face particle thrown off the plate would
+/// otherwise pull a line from the plate to wherever it flew.
+pub const MAX_DRAWN_STRETCH: Real = 4.0;
+
+/// The polyline `current` (the deformed positions of the vertices
+/// `reference`) cut into runs at every segment stretched beyond
+/// `max_stretch` times its reference length; runs of one vertex are
+/// dropped.
+pub fn clip_stretched(reference: &[Vec2], current: &[Vec2], max_stretch: Real) -> Vec<Vec<Vec2>> {
+    let mut runs: Vec<Vec<Vec2>> = Vec::new();
+    let mut run: Vec<Vec2> = Vec::new();
+    for (k, p) in current.iter().enumerate() {
+        if k > 0 {
+            let (lr, lc) = ((reference[k] - reference[k - 1]).norm(), (p - current[k - 1]).norm());
+            if lc > max_stretch * lr {
+                runs.push(std::mem::take(&mut run));
+            }
+        }
+        run.push(*p);
+    }
+    runs.push(run);
+    runs.retain(|r| r.len() > 1);
+    runs
 }
 
 /// Extent `(x_min, x_max)` of the first rigid body's outline now, m.
@@ -810,6 +845,21 @@ pub struct ExposedSummary {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A crack face whose middle vertex flew off is drawn as the two runs
+    /// either side of it; faces that only deform stay whole.
+    #[test]
+    fn crack_faces_are_cut_where_a_vertex_flew_off() {
+        let reference: Vec<Vec2> = (0..5).map(|k| Vec2::new(0.0, -1e-3 * k as Real)).collect();
+        let sheared: Vec<Vec2> = reference.iter().map(|p| p + Vec2::new(0.5 * p.y, 0.0)).collect();
+        assert_eq!(clip_stretched(&reference, &sheared, MAX_DRAWN_STRETCH), vec![sheared.clone()]);
+        let mut thrown = sheared.clone();
+        thrown[2] = Vec2::new(0.0, 0.08);
+        let runs = clip_stretched(&reference, &thrown, MAX_DRAWN_STRETCH);
+        assert_eq!(runs, vec![thrown[..2].to_vec(), thrown[3..].to_vec()]);
+        thrown[4] = Vec2::new(0.0, 0.08);
+        assert_eq!(clip_stretched(&reference, &thrown, MAX_DRAWN_STRETCH), vec![thrown[..2].to_vec()]);
+    }
 
     #[test]
     fn last_contact_time_is_the_last_row_with_contacts() {

@@ -350,8 +350,8 @@ pub fn velocity_plot(outcomes: &[Outcome], experiment: &Experiment) -> LinePlot 
         title: format!(
             "{}: {} mm plate, {} m/s impact",
             experiment.name,
-            experiment.thickness * 1e3,
-            experiment.impact_velocity
+            crate::io::short_number(experiment.thickness * 1e3),
+            crate::io::short_number(experiment.impact_velocity)
         ),
         x_label: "time (us)".into(),
         y_label: "projectile speed (m/s)".into(),

@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 pub use history::{HistoryTable, HistoryWriter};
-pub use plot::{save_field_plot, save_line_plot, FieldPlot, LinePlot, PlotError, Series};
+pub use plot::{save_field_plot, save_line_plot, short_number, FieldPlot, LinePlot, PlotError, Series};
 pub use pvd::{PvdEntry, PvdSeries};
 pub use vtu::{write_vtu, ArrayData, Cells, DataArray, VtuPiece};
 

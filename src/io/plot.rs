@@ -69,6 +69,11 @@ pub struct FieldPlot {
     pub values: Vec<f64>,
     /// Label of the colour bar (quantity and unit).
     pub value_label: String,
+    /// The quantity's physical lower bound (0 for an effective stress, a
+    /// plastic strain or a damage), if it has one: the colour bar starts
+    /// there, and values below it (the projection onto the particles can
+    /// undershoot by round-off) take its colour.
+    pub value_floor: Option<f64>,
     /// Polylines drawn in black over the points (crack paths).
     pub lines: Vec<Vec<(f64, f64)>>,
 }
@@ -320,14 +325,15 @@ fn draw_field_plot(root: &Area, plot: &FieldPlot) -> Result<(), String> {
         .draw()
         .map_err(|e| e.to_string())?;
 
-    let finite_values = finite_min_max(plot.values.iter().copied());
+    let finite_values = finite_min_max(plot.values.iter().copied())
+        .map(|(lo, hi)| plot.value_floor.map_or((lo, hi), |floor| (floor, hi.max(floor))));
     let (v0, v1) = match finite_values {
         Some((lo, hi)) if hi > lo => (lo, hi),
         other => padded_range(other),
     };
     let colour = |v: f64| {
         if v.is_finite() {
-            viridis((v - v0) / (v1 - v0))
+            viridis(((v - v0) / (v1 - v0)).clamp(0.0, 1.0))
         } else {
             RGBColor(170, 170, 170)
         }
@@ -505,6 +511,17 @@ fn tick_formatter(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
     }
 }
 
+/// `v` for a title or a legend: at most four significant digits, trailing
+/// zeros dropped (a thickness of `10.2e-3 * 1e3` reads `10.2`, not
+/// `10.200000000000001`).
+pub fn short_number(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let decimals = (3.0 - v.abs().log10().floor()).clamp(0.0, 12.0) as usize;
+    trim_zeros(&format!("{v:.decimals$}")).to_string()
+}
+
 /// Removes trailing zeros after a decimal point, and the point itself.
 fn trim_zeros(text: &str) -> &str {
     if text.contains('.') {
@@ -656,6 +673,7 @@ mod tests {
             points,
             values,
             value_label: "σ_eq (Pa)".into(),
+            value_floor: Some(0.0),
             lines: vec![vec![(0.05, 0.019), (0.052, 0.012), (0.049, 0.004)]],
         }
     }
@@ -689,6 +707,17 @@ mod tests {
         assert!(x0 <= 0.0 && x1 >= 0.1 && y0 <= -0.01 && y1 >= 0.02);
         let (sx, sy) = ((x1 - x0) / 700.0, (y1 - y0) / 500.0);
         assert!((sx - sy).abs() <= 1e-12 * sx, "{sx} {sy}");
+    }
+
+    #[test]
+    fn short_numbers_for_titles() {
+        assert_eq!(short_number(10.2e-3 * 1e3), "10.2");
+        assert_eq!(short_number(11.1), "11.1");
+        assert_eq!(short_number(173.7), "173.7");
+        assert_eq!(short_number(298.0), "298");
+        assert_eq!(short_number(0.000123456), "0.0001235");
+        assert_eq!(short_number(-2.5), "-2.5");
+        assert_eq!(short_number(0.0), "0");
     }
 
     #[test]
