@@ -7,41 +7,18 @@ use plugsim::residual::Verdict;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
-/// A 4 mm plate, 24 mm wide, and a blunt 8 mm projectile (as the fracture
-/// tests' small impact): seconds per run.
-const SMALL_PLATE: &str = r#"
-title = "small plate, blunt projectile"
-[geometry]
-mode = "plane_strain"
-[[bodies]]
-name = "plate"
-material = "weldox_460e"
-[bodies.rectangle]
-x_min = -0.012
-x_max = 0.012
-y_min = 0.0
-y_max = 0.004
-layers = 9
-[[bodies.supports]]
-region = { x_min = -0.012, x_max = -0.011, y_min = 0.0, y_max = 0.004 }
-[[bodies.supports]]
-region = { x_min = 0.011, x_max = 0.012, y_min = 0.0, y_max = 0.004 }
-[[rigid_bodies]]
-name = "projectile"
-rectangle = { center = [0.0, 0.01405], width = 0.008, height = 0.02 }
-density = 7850.0
-velocity = [0.0, -400.0]
-[fracture]
-criterion = "effective_strain"
-[time]
-end = 100.0e-6
-stop_after_release = 2.0e-6
-[output]
-interval = 1.0e-5
-"#;
+mod common;
+
+/// The shared small impact (`tests/common/small_impact.toml`), run until
+/// 2 µs after the projectile's release, at most 100 µs.
+fn small_plate() -> String {
+    assert!(common::SMALL_IMPACT.contains("end = 12.0e-6"), "the shared case's end time moved");
+    common::SMALL_IMPACT.replace("end = 12.0e-6", "end = 100.0e-6\nstop_after_release = 2.0e-6")
+        + "[output]\ninterval = 1.0e-5\n"
+}
 
 fn setup(name: &str, jobs: usize) -> Setup {
-    let case = Case::from_str_with(SMALL_PLATE, "small", &[]).unwrap();
+    let case = Case::from_str_with(&small_plate(), "small", &[]).unwrap();
     let projectile = select_projectile(&case, "small", None).unwrap();
     let out_dir = std::env::temp_dir().join(format!("plugsim-ballistic-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out_dir);
@@ -85,7 +62,7 @@ fn a_perforating_run_reports_its_residual_velocity() {
 
 #[test]
 fn a_case_without_a_moving_rigid_body_is_refused_by_name() {
-    let text = SMALL_PLATE.replace("velocity = [0.0, -400.0]", "velocity = [0.0, 0.0]");
+    let text = small_plate().replace("velocity = [0.0, -400.0]", "velocity = [0.0, 0.0]");
     let case = Case::from_str_with(&text, "still", &[]).unwrap();
     let e = select_projectile(&case, "still.toml", None).unwrap_err().to_string();
     assert!(e.contains("still.toml") && e.contains("no rigid body with an initial velocity"), "{e}");

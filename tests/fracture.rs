@@ -417,36 +417,8 @@ fn crack_faces_are_traction_free_under_tension() {
     assert!(s_cracked < 0.15 * s_intact, "faces traction-free: {s_cracked:e} vs {s_intact:e} Pa");
 }
 
-const SMALL_IMPACT: &str = r#"
-title = "small plate, blunt projectile"
-[geometry]
-mode = "plane_strain"
-[[bodies]]
-name = "plate"
-material = "weldox_460e"
-[bodies.rectangle]
-x_min = -0.012
-x_max = 0.012
-y_min = 0.0
-y_max = 0.004
-layers = 9
-[[bodies.supports]]
-region = { x_min = -0.012, x_max = -0.011, y_min = 0.0, y_max = 0.004 }
-[[bodies.supports]]
-region = { x_min = 0.011, x_max = 0.012, y_min = 0.0, y_max = 0.004 }
-[[rigid_bodies]]
-name = "projectile"
-rectangle = { center = [0.0, 0.01405], width = 0.008, height = 0.02 }
-density = 7850.0
-velocity = [0.0, -400.0]
-[fracture]
-criterion = "effective_strain"
-[time]
-end = 12.0e-6
-"#;
-
 fn small_impact(end: Real) -> Simulation {
-    let case = Case::from_str_with(SMALL_IMPACT, "small", &[format!("time.end={end}")]).unwrap();
+    let case = Case::from_str_with(common::SMALL_IMPACT, "small", &[format!("time.end={end}")]).unwrap();
     let mut sim = plugsim::run::build_simulation(&case.resolved()).unwrap();
     while sim.time < end {
         sim.step().unwrap();
@@ -602,7 +574,7 @@ fn run_stops_after_the_projectile_is_released() {
     let wait = 1.0e-6;
     let set =
         ["time.end=4e-5".to_string(), format!("time.stop_after_release={wait}"), "output.interval=1e-5".to_string()];
-    let case = Case::from_str_with(SMALL_IMPACT, "small", &set).unwrap().resolved();
+    let case = Case::from_str_with(common::SMALL_IMPACT, "small", &set).unwrap().resolved();
     let cfg = RunConfig::new(dir.clone(), true, RunInfo::current("test", &[]));
     let s = execute(&case, &cfg, &mut |_| {}).unwrap();
     let perforated = s.perforation.expect("the small plate is perforated");
@@ -617,7 +589,7 @@ fn run_stops_after_the_projectile_is_released() {
     let from = released.max(perforated);
     assert!(s.time >= from + wait && s.time <= from + wait + 20.0 * s.dt, "{} {released} {perforated}", s.time);
     // a negative wait is rejected, naming the field
-    let bad = Case::from_str_with(SMALL_IMPACT, "small", &["time.stop_after_release=-1e-6".to_string()]);
+    let bad = Case::from_str_with(common::SMALL_IMPACT, "small", &["time.stop_after_release=-1e-6".to_string()]);
     assert!(bad.is_err_and(|e| e.to_string().contains("time.stop_after_release")));
     std::fs::remove_dir_all(&dir).ok();
 }

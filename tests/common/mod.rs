@@ -4,6 +4,11 @@ use plugsim::case::Case;
 use plugsim::discretize::RectangleGrid;
 use plugsim::math::Real;
 
+/// A 4 mm plate and a blunt 8 mm projectile at 400 m/s with cracks
+/// (`small_impact.toml`), 12 µs: the fracture and ballistic tests' impact.
+#[allow(dead_code)] // not every test binary uses every helper
+pub const SMALL_IMPACT: &str = include_str!("small_impact.toml");
+
 /// A uniform lattice of `nx × ny` particles of spacing `h` on
 /// `[0, (nx−1)h] × [0, (ny−1)h]`, finest (uniform) from x = 0, support
 /// factor 2, 2×2 Gauss points.
