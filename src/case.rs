@@ -305,7 +305,7 @@ impl ProjectileSpec {
         if p.is_empty() {
             if let Some(g) = self.projectile() {
                 let ln = g.nose_length();
-                if !(ln < self.length) {
+                if ln.partial_cmp(&self.length) != Some(std::cmp::Ordering::Less) {
                     p.push((
                         "length",
                         format!("{} m must exceed the nose length {ln:.6} m (the shank would be empty)", self.length),
