@@ -5,7 +5,10 @@
 //! The same structs build cases in tests; [`Case::resolved_toml`] writes the
 //! case with every default expanded, which each run stores beside its output.
 
-use crate::contact::{mass_axisymmetric, mass_plane_strain, rectangle_outline, ContactError, RigidBody};
+use crate::contact::projectile::{cone_length, nose_segment_length};
+use crate::contact::{
+    mass_axisymmetric, mass_plane_strain, rectangle_outline, ContactError, NoseShape, Projectile, RigidBody,
+};
 use crate::discretize::RectangleGrid;
 use crate::geometry::GeometryMode;
 use crate::material::{Constitutive, Elastic, JohnsonCook, Material, ThermalProperties};
@@ -141,11 +144,18 @@ pub struct RigidBodySpec {
     /// A rectangle: `{ center = [x, y], width, height }`, m.
     #[serde(default)]
     pub rectangle: Option<RigidRectangle>,
-    /// Mass, kg (per unit depth in plane strain). Give this or `density`.
+    /// A projectile by nose shape: `{ nose = "blunt" | "hemispherical" |
+    /// "conical" | "ogival", tip = [x, y], diameter, length, ... }`, m (see
+    /// [`ProjectileSpec`]). Give exactly one of `outline`, `rectangle` and
+    /// `projectile`.
+    #[serde(default)]
+    pub projectile: Option<ProjectileSpec>,
+    /// Mass, kg (per unit depth in plane strain: the section's `ρ A`; the
+    /// whole body in axisymmetry). Give this or `density`.
     #[serde(default)]
     pub mass: Option<Real>,
     /// Density, kg/m³: mass from the area (plane strain) or the volume of
-    /// revolution (axisymmetry).
+    /// revolution (axisymmetry) of the outline.
     #[serde(default)]
     pub density: Option<Real>,
     /// Initial velocity (vx, vy), m/s.
@@ -165,6 +175,146 @@ pub struct RigidRectangle {
     pub width: Real,
     /// Extent along y, m.
     pub height: Real,
+}
+
+/// `projectile = { ... }` of a `[[rigid_bodies]]` entry: a projectile by
+/// nose shape ([`crate::contact::projectile`]), SI units. The nose points
+/// along −y, onto a plate below it (the bodies translate only, so the
+/// direction is that of the outline, not of the velocity). Its outline is
+/// the full section through the axis in both geometry modes; curved noses
+/// are faceted at a quarter of the smallest particle spacing of the
+/// deformable bodies ([`crate::contact::projectile`] gives the rule). No
+/// field has a default: a projectile has no typical size, and each
+/// parameter applies to one nose only (given for another it is an error,
+/// not ignored).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProjectileSpec {
+    /// `"blunt"` (flat face), `"hemispherical"` (a half sphere of the
+    /// shank's radius), `"conical"` (give `nose_length` or
+    /// `nose_angle_deg`), `"ogival"` (tangent ogive; give
+    /// `caliber_radius_head`).
+    pub nose: NoseKind,
+    /// Position (x, y) of the tip, m: the nose's foremost point on the axis
+    /// (the centre of a blunt face). In axisymmetry x must be 0.
+    pub tip: [Real; 2],
+    /// Shank diameter, m.
+    pub diameter: Real,
+    /// Overall length from the tip to the back face, m; longer than the nose.
+    pub length: Real,
+    /// Conical only: length of the cone from the tip to the shank, m.
+    #[serde(default)]
+    pub nose_length: Option<Real>,
+    /// Conical only: included apex angle of the cone, degrees, in (0, 180)
+    /// (`nose_length = D / (2 tan(α/2))`). Give this or `nose_length`.
+    #[serde(default)]
+    pub nose_angle_deg: Option<Real>,
+    /// Ogival only: calibre-radius-head ψ, the ogive's arc radius over the
+    /// diameter, ≥ 0.5 (0.5 is the hemisphere); nose length `R √(4ψ − 1)`.
+    #[serde(default)]
+    pub caliber_radius_head: Option<Real>,
+}
+
+/// The nose shapes of [`ProjectileSpec`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NoseKind {
+    Blunt,
+    Hemispherical,
+    Conical,
+    Ogival,
+}
+
+impl ProjectileSpec {
+    /// The geometry; `None` when a parameter the nose needs is missing or
+    /// out of range (see [`ProjectileSpec::problems`]).
+    pub fn projectile(&self) -> Option<Projectile> {
+        let nose = match self.nose {
+            NoseKind::Blunt => NoseShape::Blunt,
+            NoseKind::Hemispherical => NoseShape::Hemispherical,
+            NoseKind::Conical => NoseShape::Conical {
+                nose_length: match (self.nose_length, self.nose_angle_deg) {
+                    (Some(l), None) => l,
+                    (None, Some(a)) => cone_length(0.5 * self.diameter, a),
+                    _ => return None,
+                },
+            },
+            NoseKind::Ogival => NoseShape::Ogival { caliber_radius_head: self.caliber_radius_head? },
+        };
+        Some(Projectile { diameter: self.diameter, length: self.length, nose })
+    }
+
+    /// Problems, each as (field, message), the field relative to the
+    /// `projectile` table.
+    pub fn problems(&self, mode: GeometryMode) -> Vec<(&'static str, String)> {
+        let mut p = Vec::new();
+        let name = match self.nose {
+            NoseKind::Blunt => "blunt",
+            NoseKind::Hemispherical => "hemispherical",
+            NoseKind::Conical => "conical",
+            NoseKind::Ogival => "ogival",
+        };
+        if !self.tip.iter().all(|c| c.is_finite()) {
+            p.push(("tip", format!("must be finite (in m), got {:?}", self.tip)));
+        } else if mode == GeometryMode::Axisymmetric && self.tip[0] != 0.0 {
+            p.push(("tip", format!("must lie on the axis (x = 0) in axisymmetry, got x = {}", self.tip[0])));
+        }
+        for (field, v) in [("diameter", self.diameter), ("length", self.length)] {
+            if !(v.is_finite() && v > 0.0) {
+                p.push((field, format!("must be a positive number (in m), got {v}")));
+            }
+        }
+        let conical = self.nose == NoseKind::Conical;
+        let ogival = self.nose == NoseKind::Ogival;
+        for (field, given, applies, owner) in [
+            ("nose_length", self.nose_length.is_some(), conical, "conical"),
+            ("nose_angle_deg", self.nose_angle_deg.is_some(), conical, "conical"),
+            ("caliber_radius_head", self.caliber_radius_head.is_some(), ogival, "ogival"),
+        ] {
+            if given && !applies {
+                p.push((field, format!("applies to {owner} noses only, not to a {name} one")));
+            }
+        }
+        if conical {
+            match (self.nose_length, self.nose_angle_deg) {
+                (Some(_), Some(_)) => {
+                    p.push(("nose_length", "give either `nose_length` or `nose_angle_deg`, not both".into()))
+                }
+                (None, None) => {
+                    p.push(("nose_length", "a conical nose needs `nose_length` or `nose_angle_deg`".into()))
+                }
+                (Some(l), None) if !(l.is_finite() && l > 0.0) => {
+                    p.push(("nose_length", format!("must be a positive number (in m), got {l}")))
+                }
+                (None, Some(a)) if !(a.is_finite() && a > 0.0 && a < 180.0) => {
+                    p.push(("nose_angle_deg", format!("must lie in (0, 180) degrees, got {a}")))
+                }
+                _ => {}
+            }
+        }
+        if ogival {
+            match self.caliber_radius_head {
+                None => p.push(("caliber_radius_head", "an ogival nose needs `caliber_radius_head`".into())),
+                Some(c) if !(c.is_finite() && c >= 0.5) => p.push((
+                    "caliber_radius_head",
+                    format!("must be at least 0.5 (a hemisphere; smaller arcs cannot meet the axis), got {c}"),
+                )),
+                _ => {}
+            }
+        }
+        if p.is_empty() {
+            if let Some(g) = self.projectile() {
+                let ln = g.nose_length();
+                if ln.partial_cmp(&self.length) != Some(std::cmp::Ordering::Less) {
+                    p.push((
+                        "length",
+                        format!("{} m must exceed the nose length {ln:.6} m (the shank would be empty)", self.length),
+                    ));
+                }
+            }
+        }
+        p
+    }
 }
 
 /// `[heat]`: heat conduction between particles after the adiabatic material
@@ -488,10 +638,21 @@ impl Case {
             if !names.insert(rb.name.clone()) {
                 add(format!("{k}.name"), format!("duplicate body name '{}'", rb.name));
             }
-            match (&rb.outline, &rb.rectangle) {
-                (Some(_), Some(_)) => add(k.clone(), "give either `outline` or `rectangle`, not both".into()),
-                (None, None) => add(k.clone(), "missing the shape: give `outline` or `rectangle`".into()),
-                (Some(o), None) => {
+            let shapes = [rb.outline.is_some(), rb.rectangle.is_some(), rb.projectile.is_some()];
+            let shape_given = shapes.iter().filter(|&&s| s).count() == 1;
+            match (&rb.outline, &rb.rectangle, &rb.projectile) {
+                _ if shapes.iter().filter(|&&s| s).count() > 1 => {
+                    add(k.clone(), "give one of `outline`, `rectangle` and `projectile`, not several".into())
+                }
+                (None, None, None) => {
+                    add(k.clone(), "missing the shape: give `outline`, `rectangle` or `projectile`".into())
+                }
+                (None, None, Some(proj)) => {
+                    for (field, message) in proj.problems(self.geometry.mode) {
+                        add(format!("{k}.projectile.{field}"), message);
+                    }
+                }
+                (Some(o), _, _) => {
                     if o.len() < 3 {
                         add(format!("{k}.outline"), format!("a polygon needs at least 3 vertices, got {}", o.len()));
                     } else if signed_area(o) <= 0.0 {
@@ -501,7 +662,7 @@ impl Case {
                         );
                     }
                 }
-                (None, Some(rect)) => {
+                (None, Some(rect), _) => {
                     positive(&mut add, &format!("{k}.rectangle.width"), rect.width, "m");
                     positive(&mut add, &format!("{k}.rectangle.height"), rect.height, "m");
                 }
@@ -512,7 +673,8 @@ impl Case {
                 (Some(m), None) => positive(&mut add, &format!("{k}.mass"), m, "kg"),
                 (None, Some(d)) => positive(&mut add, &format!("{k}.density"), d, "kg/m^3"),
             }
-            if rb.outline.is_some() != rb.rectangle.is_some() && rb.mass.is_some() != rb.density.is_some() {
+            let shape_valid = rb.projectile.as_ref().is_none_or(|p| p.problems(self.geometry.mode).is_empty());
+            if shape_given && shape_valid && rb.mass.is_some() != rb.density.is_some() {
                 if let Err(e) = self.rigid_body(rb) {
                     add(k.clone(), e.to_string());
                 }
@@ -662,10 +824,14 @@ impl Case {
     /// area in plane strain, by volume of revolution in axisymmetry),
     /// velocity, prescribed motion.
     pub fn rigid_body(&self, rb: &RigidBodySpec) -> Result<RigidBody, ContactError> {
-        let (outline, position) = match (&rb.outline, &rb.rectangle) {
-            (Some(o), _) => (o.iter().map(|v| Vec2::new(v[0], v[1])).collect(), Vec2::zeros()),
-            (None, Some(r)) => (rectangle_outline(r.width, r.height), Vec2::new(r.center[0], r.center[1])),
-            (None, None) => (Vec::new(), Vec2::zeros()),
+        let (outline, position) = match (&rb.outline, &rb.rectangle, &rb.projectile) {
+            (Some(o), _, _) => (o.iter().map(|v| Vec2::new(v[0], v[1])).collect(), Vec2::zeros()),
+            (None, Some(r), _) => (rectangle_outline(r.width, r.height), Vec2::new(r.center[0], r.center[1])),
+            (None, None, Some(p)) => (
+                p.projectile().map_or_else(Vec::new, |g| g.outline(nose_segment_length(self.smallest_spacing()))),
+                Vec2::new(p.tip[0], p.tip[1]),
+            ),
+            (None, None, None) => (Vec::new(), Vec2::zeros()),
         };
         let mass = match (rb.mass, rb.density) {
             (Some(m), _) => m,
@@ -681,6 +847,29 @@ impl Case {
         // In axisymmetry a body is a body of revolution about the axis: it
         // cannot move radially.
         Ok(if self.geometry.mode == GeometryMode::Axisymmetric { body.held_on_axis() } else { body })
+    }
+
+    /// The smallest particle spacing of the deformable bodies' grids, m
+    /// (the fine spacing along x or the thickness spacing, whichever is
+    /// smaller): the scale curved projectile noses are faceted to
+    /// ([`crate::contact::projectile`]). Without a valid body, the spacing
+    /// of 24 rows through a 10 mm plate (0.42 mm), a typical value, so that
+    /// a case being validated still gets an outline.
+    pub fn smallest_spacing(&self) -> Real {
+        let h = self
+            .bodies
+            .iter()
+            .map(|b| {
+                let layer = b.rectangle.layer_spacing();
+                b.rectangle.fine_spacing.map_or(layer, |f| f.min(layer))
+            })
+            .filter(|h| h.is_finite() && *h > 0.0)
+            .fold(Real::INFINITY, Real::min);
+        if h.is_finite() {
+            h
+        } else {
+            0.01 / 23.0
+        }
     }
 
     /// All rigid bodies.

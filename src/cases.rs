@@ -124,11 +124,29 @@ pub const BUILTIN_CASES: &[(&str, &str, &str)] = &[
         "Borvik Case II (173.7 m/s, 10.2 mm), axisymmetric, fine, damage cracks, Borvik's modified material",
     ),
     (
+        "borvik-2002-12mm-blunt",
+        include_str!("../cases/borvik-2002-12mm-blunt.toml"),
+        "Borvik et al. 2002 nose shapes: blunt nose, 12 mm Weldox 460 E, 300 m/s (not a test speed), axisymmetric, coarse",
+    ),
+    (
+        "borvik-2002-12mm-hemispherical",
+        include_str!("../cases/borvik-2002-12mm-hemispherical.toml"),
+        "Borvik et al. 2002 nose shapes: hemispherical nose, 12 mm Weldox 460 E, 300 m/s (not a test speed), axisymmetric, coarse",
+    ),
+    (
         "borvik-1-nofracture",
         include_str!("../cases/borvik-1-nofracture.toml"),
         "Borvik Case I (298 m/s, 11.1 mm Weldox), plane strain, coarse, no fracture",
     ),
 ];
+
+/// Børvik et al.'s nose-shape experiments (IJIE 27, 2002; the reference
+/// data found is in `cases/reference/borvik-experiments.toml`): the
+/// projectile given by its nose ([`crate::case::ProjectileSpec`]) on a 12 mm
+/// plate, with the numerical parameters of the coarse axisymmetric member of
+/// [`borvik_family`] (checked by `tests/reference_cases.rs`). The conical
+/// nose is missing: its apex angle was not found.
+pub const BORVIK_NOSE_CASES: &[&str] = &["borvik-2002-12mm-blunt", "borvik-2002-12mm-hemispherical"];
 
 /// Short names for the paper's models: `(alias, built-in case)`.
 pub const ALIASES: &[(&str, &str)] = &[("borvik-1", "borvik-1-plane-strain"), ("borvik-2", "borvik-2-plane-strain")];

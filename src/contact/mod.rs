@@ -3,7 +3,9 @@
 //!
 //! - [`rigid`]: rigid bodies with polygonal outlines (the masters), their
 //!   mass from a section (plane strain) or a volume of revolution
-//!   (axisymmetry), and their explicit update.
+//!   (axisymmetry), and their explicit update; [`projectile`]: the
+//!   outlines of projectiles by nose shape (blunt, hemispherical, conical,
+//!   ogival).
 //! - [`surface`]: geometric detection of surface particles, the initial
 //!   slave set; [`slave`]: the slave set and its pairing cache.
 //! - [`grid`]: the uniform cell grid of the coarse search;
@@ -59,6 +61,7 @@
 
 pub mod force;
 pub mod grid;
+pub mod projectile;
 pub mod rigid;
 pub mod search;
 pub mod slave;
@@ -66,6 +69,7 @@ pub mod surface;
 pub mod system;
 
 pub use force::Spreading;
+pub use projectile::{NoseShape, Projectile};
 pub use rigid::{mass_axisymmetric, mass_plane_strain, rectangle_outline, RigidBody};
 pub use search::{search_rigid_polygon, search_rigid_polygon_brute_force, Projection};
 pub use slave::{MasterFeature, Pairing, SlaveSet};
