@@ -768,6 +768,9 @@ impl Case {
                 );
             }
         }
+        if p.is_empty() {
+            p.extend(self.overlaps_at_start().into_iter().map(|(key, message)| Problem { key, message }));
+        }
         p
     }
 
@@ -823,6 +826,46 @@ impl Case {
     /// The rigid body of a (validated) spec: outline, mass (from density by
     /// area in plane strain, by volume of revolution in axisymmetry),
     /// velocity, prescribed motion.
+    /// Bodies that overlap at t = 0, as `(key, message)` naming both: the
+    /// deformable bodies' rectangles and the rigid bodies' outlines at their
+    /// initial positions ([`crate::contact::polygons_overlap`]; touching is
+    /// allowed). Contact assumes bodies start apart: a projectile placed
+    /// inside the plate would be pushed out in one step with an impulse that
+    /// inverts the points it crosses. Meaningful once every body is valid.
+    pub fn overlaps_at_start(&self) -> Vec<(String, String)> {
+        let corners = |g: &RectangleGrid| {
+            vec![
+                Vec2::new(g.x_min, g.y_min),
+                Vec2::new(g.x_max, g.y_min),
+                Vec2::new(g.x_max, g.y_max),
+                Vec2::new(g.x_min, g.y_max),
+            ]
+        };
+        let mut shapes: Vec<(String, String, Vec<Vec2>)> = self
+            .bodies
+            .iter()
+            .enumerate()
+            .map(|(i, b)| (format!("bodies[{i}].rectangle"), b.name.clone(), corners(&b.rectangle)))
+            .collect();
+        for (r, rb) in self.rigid_bodies.iter().enumerate() {
+            if let Ok(body) = self.rigid_body(rb) {
+                shapes.push((format!("rigid_bodies[{r}]"), rb.name.clone(), body.outline_global().collect()));
+            }
+        }
+        let mut found = Vec::new();
+        for (j, (key, name, shape)) in shapes.iter().enumerate() {
+            for (_, other, earlier) in &shapes[..j] {
+                if crate::contact::polygons_overlap(shape, earlier) {
+                    found.push((
+                        key.clone(),
+                        format!("body '{name}' overlaps body '{other}' at t = 0; place the two apart (they may touch)"),
+                    ));
+                }
+            }
+        }
+        found
+    }
+
     pub fn rigid_body(&self, rb: &RigidBodySpec) -> Result<RigidBody, ContactError> {
         let (outline, position) = match (&rb.outline, &rb.rectangle, &rb.projectile) {
             (Some(o), _, _) => (o.iter().map(|v| Vec2::new(v[0], v[1])).collect(), Vec2::zeros()),

@@ -118,3 +118,33 @@ fn missing_file_is_a_clear_error() {
     let e = Case::load(std::path::Path::new("/nonexistent/case.toml"), &[]).unwrap_err().to_string();
     assert!(e.contains("/nonexistent/case.toml") && e.contains("cannot read"), "{e}");
 }
+
+/// Bodies placed inside each other at t = 0 are refused before the run,
+/// naming both: a projectile sunk 1 mm into the plate, a rounded nose whose
+/// tip is below the surface, two plates that overlap; a projectile resting
+/// on the plate and two plates in contact are accepted (issue #20).
+#[test]
+fn bodies_overlapping_at_the_start_are_refused_naming_both() {
+    let borvik = include_str!("../cases/borvik-1-axisymmetric.toml");
+    let err =
+        Case::from_str_with(borvik, "bad.toml", &["rigid_bodies.projectile.rectangle.center=[0.0,0.0501]".into()])
+            .unwrap_err()
+            .to_string();
+    assert!(err.contains("rigid_bodies[0]") && err.contains("'projectile'") && err.contains("'plate'"), "{err}");
+    // Nose resting on the surface (the plate's top is y = 11.1 mm).
+    Case::from_str_with(borvik, "ok.toml", &["rigid_bodies.projectile.rectangle.center=[0.0,0.0511]".into()]).unwrap();
+    let nose = include_str!("../cases/borvik-2002-12mm-hemispherical.toml");
+    let err = Case::from_str_with(nose, "bad.toml", &["rigid_bodies.0.projectile.tip=[0.0,0.0115]".into()])
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("overlaps body 'plate'"), "{err}");
+    let two_plates = |lower_top: f64| {
+        format!(
+            "{GOOD}\n[[bodies]]\nname = \"backing\"\nmaterial = \"steel\"\n[bodies.rectangle]\n\
+             x_min = -0.06\nx_max = 0.06\ny_min = -0.005\ny_max = {lower_top}\nlayers = 6\n"
+        )
+    };
+    let err = err_of(&two_plates(0.001));
+    assert!(err.contains("bodies[1].rectangle") && err.contains("'backing' overlaps body 'plate'"), "{err}");
+    Case::from_str_with(&two_plates(0.0), "ok.toml", &[]).unwrap();
+}

@@ -70,7 +70,7 @@ pub mod system;
 
 pub use force::Spreading;
 pub use projectile::{NoseShape, Projectile};
-pub use rigid::{mass_axisymmetric, mass_plane_strain, rectangle_outline, RigidBody};
+pub use rigid::{mass_axisymmetric, mass_plane_strain, polygons_overlap, rectangle_outline, RigidBody};
 pub use search::{search_rigid_polygon, search_rigid_polygon_brute_force, Projection};
 pub use slave::{MasterFeature, Pairing, SlaveSet};
 pub use surface::{detect_surface, SurfaceDetection};

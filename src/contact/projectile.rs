@@ -75,6 +75,13 @@ pub struct Projectile {
     pub nose: NoseShape,
 }
 
+/// Most facets on one nose arc: 20,000 facets put a 10 mm hemisphere
+/// within 0.2 nm of its surface. A case whose particle spacing would ask
+/// for more (spacings below about 3 µm on a 20 mm nose) is refused by the
+/// memory guard anyway; the cap keeps its validation from building an
+/// outline of unbounded size first (found by `tests/robustness.rs`'s fuzz).
+pub const MAX_ARC_FACETS: Real = 20_000.0;
+
 /// The facet length of curved noses for particles of smallest spacing `h`:
 /// `h/4` (module doc).
 pub fn nose_segment_length(h: Real) -> Real {
@@ -139,7 +146,7 @@ impl Projectile {
                 let theta = (ln / rho).clamp(-1.0, 1.0).asin();
                 let by_length = (rho * theta / facet).ceil();
                 let by_turn = (theta / MAX_FACET_TURN_DEG.to_radians()).ceil();
-                let n = by_length.max(by_turn).max(1.0) as usize;
+                let n = by_length.max(by_turn).clamp(1.0, MAX_ARC_FACETS) as usize;
                 for k in 0..=n {
                     let a = -theta * (1.0 - k as Real / n as Real);
                     p.push(if k == 0 { Vec2::zeros() } else { centre + Vec2::new(a.cos(), a.sin()) * rho });

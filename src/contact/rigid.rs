@@ -227,6 +227,55 @@ pub fn rectangle_outline(width: Real, height: Real) -> Vec<Vec2> {
     vec![Vec2::new(-a, -b), Vec2::new(a, -b), Vec2::new(a, b), Vec2::new(-a, b)]
 }
 
+/// Whether the interiors of two closed polygons overlap: an edge of one
+/// properly crosses an edge of the other, or a vertex, an edge midpoint or
+/// the vertex mean of one lies strictly inside the other. Polygons that only touch (a shared
+/// edge, a vertex on an edge) do not overlap. Used to refuse bodies placed
+/// inside each other at t = 0 ([`crate::contact`] assumes they start apart).
+pub fn polygons_overlap(a: &[Vec2], b: &[Vec2]) -> bool {
+    let scale = a.iter().chain(b).map(|v| v.amax()).fold(0.0, Real::max).max(Real::MIN_POSITIVE);
+    let eps = 1e-12 * scale * scale;
+    // Sign of the turn p -> q -> r, zero within round-off.
+    let turn = |p: &Vec2, q: &Vec2, r: &Vec2| {
+        let t = (q - p).perp(&(r - p));
+        if t > eps {
+            1
+        } else if t < -eps {
+            -1
+        } else {
+            0
+        }
+    };
+    let edges = |poly: &[Vec2]| (0..poly.len()).map(|k| (poly[k], poly[(k + 1) % poly.len()])).collect::<Vec<_>>();
+    let (ea, eb) = (edges(a), edges(b));
+    let crossing = ea
+        .iter()
+        .any(|(p, q)| eb.iter().any(|(r, s)| turn(p, q, r) * turn(p, q, s) < 0 && turn(r, s, p) * turn(r, s, q) < 0));
+    // Strictly inside: off every edge, with a non-zero winding number.
+    let inside = |x: &Vec2, edges: &[(Vec2, Vec2)]| {
+        if edges.iter().any(|(p, q)| turn(p, q, x) == 0 && (x - p).dot(&(x - q)) <= eps) {
+            return false;
+        }
+        let winding: i32 = edges
+            .iter()
+            .map(|(p, q)| match (p.y <= x.y, q.y <= x.y) {
+                (true, false) if turn(p, q, x) > 0 => 1,
+                (false, true) if turn(p, q, x) < 0 => -1,
+                _ => 0,
+            })
+            .sum();
+        winding != 0
+    };
+    // Vertices, edge midpoints and the vertex mean: the midpoints find two
+    // rectangles of one width stacked into each other, whose corners lie on
+    // each other's sides.
+    let samples = |poly: &[Vec2], edges: &[(Vec2, Vec2)]| {
+        let mean = poly.iter().sum::<Vec2>() / poly.len() as Real;
+        poly.iter().copied().chain(edges.iter().map(|(p, q)| 0.5 * (p + q))).chain([mean]).collect::<Vec<_>>()
+    };
+    crossing || samples(a, &ea).iter().any(|v| inside(v, &eb)) || samples(b, &eb).iter().any(|v| inside(v, &ea))
+}
+
 /// Signed area of a closed polygon (shoelace), m²; positive when
 /// counter-clockwise.
 pub fn polygon_signed_area(outline: &[Vec2]) -> Real {
@@ -346,6 +395,53 @@ fn segments_intersect(a: Vec2, b: Vec2, c: Vec2, d: Vec2) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Overlap means interiors meet: crossing, containment (also with the
+    /// vertices on the other's boundary), a vertex poking in; touching along
+    /// an edge or at a vertex, and a gap, are not overlaps. An L-shaped
+    /// (non-convex) polygon whose notch holds the other is not overlapped.
+    #[test]
+    fn polygon_overlap_is_interiors_meeting() {
+        let square = |x: Real, y: Real, a: Real| {
+            vec![Vec2::new(x, y), Vec2::new(x + a, y), Vec2::new(x + a, y + a), Vec2::new(x, y + a)]
+        };
+        let unit = square(0.0, 0.0, 1.0);
+        let cases = [
+            (square(0.5, 0.5, 1.0), true, "corner in corner"),
+            (square(0.25, 0.25, 0.5), true, "inside"),
+            (square(-1.0, -1.0, 3.0), true, "around"),
+            (square(0.0, 0.0, 1.0), true, "the same"),
+            (square(0.0, 0.0, 0.5), true, "inside, sharing two edges"),
+            (square(1.0, 0.0, 1.0), false, "sharing an edge"),
+            (square(1.0, 1.0, 1.0), false, "sharing a vertex"),
+            (square(1.0 + 1e-6, 0.0, 1.0), false, "a gap"),
+            (
+                vec![Vec2::new(0.0, -0.5), Vec2::new(1.0, -0.5), Vec2::new(1.0, 0.1), Vec2::new(0.0, 0.1)],
+                true,
+                "one width, stacked into it",
+            ),
+            (vec![Vec2::new(0.5, -0.5), Vec2::new(0.6, 0.5), Vec2::new(0.4, 0.5)], true, "a tip poking in"),
+            (
+                vec![Vec2::new(-0.5, 0.4), Vec2::new(1.5, 0.4), Vec2::new(1.5, 0.6), Vec2::new(-0.5, 0.6)],
+                true,
+                "a bar across",
+            ),
+        ];
+        for (other, overlap, what) in cases {
+            assert_eq!(polygons_overlap(&unit, &other), overlap, "{what}");
+            assert_eq!(polygons_overlap(&other, &unit), overlap, "{what}, swapped");
+        }
+        let l_shape = vec![
+            Vec2::new(0.0, 0.0),
+            Vec2::new(2.0, 0.0),
+            Vec2::new(2.0, 1.0),
+            Vec2::new(1.0, 1.0),
+            Vec2::new(1.0, 2.0),
+            Vec2::new(0.0, 2.0),
+        ];
+        assert!(!polygons_overlap(&l_shape, &square(1.2, 1.2, 0.5)), "in the notch");
+        assert!(polygons_overlap(&l_shape, &square(0.2, 0.2, 0.5)), "in the arm");
+    }
 
     #[test]
     fn rectangle_normals_point_outward() {
