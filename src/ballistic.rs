@@ -160,6 +160,9 @@ pub struct Shot {
     pub plug_mass: Option<Real>,
     /// Simulated time at the end, s.
     pub end_time: Real,
+    /// The largest physical particle speed of the run, m/s
+    /// ([`crate::step::FastestParticle`]).
+    pub fastest: Real,
     pub steps: u64,
     /// Wall time, s.
     pub wall: Real,
@@ -453,6 +456,7 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
                     perforation: s.perforation,
                     plug_mass: s.plug.as_ref().map(|p| p.mass),
                     end_time: s.time,
+                    fastest: s.fastest.speed,
                     steps: s.steps,
                     wall: t.elapsed().as_secs_f64(),
                     dir,
@@ -600,30 +604,34 @@ pub fn read_experiments(path: &Path) -> Result<Vec<(Real, Real)>, BallisticError
 
 /// The table as (Markdown, CSV).
 pub fn table(study: &Study) -> (String, String) {
-    let mut md = String::from("| v_i (m/s) | v_r (m/s) | outcome | perforation (us) | plug mass (kg; kg/m in plane strain) | end (us) | steps | wall (s) |\n|---|---|---|---|---|---|---|---|\n");
-    let mut csv = String::from("v_i_m_s,v_r_m_s,perforated,outcome,perforation_us,plug_mass,end_us,steps,wall_s,dir\n");
+    let mut md = String::from("| v_i (m/s) | v_r (m/s) | outcome | perforation (us) | plug mass (kg; kg/m in plane strain) | end (us) | fastest particle (m/s) | steps | wall (s) |\n|---|---|---|---|---|---|---|---|---|\n");
+    let mut csv = String::from(
+        "v_i_m_s,v_r_m_s,perforated,outcome,perforation_us,plug_mass,end_us,fastest_particle_m_s,steps,wall_s,dir\n",
+    );
     let opt = |v: Option<Real>, f: &dyn Fn(Real) -> String| v.map_or_else(String::new, f);
     for s in &study.shots {
         let vr = opt(s.residual(), &|v| format!("{v:.2}"));
         let perf = opt(s.perforation, &|t| format!("{:.2}", t * 1e6));
         let mass = opt(s.plug_mass, &|m| format!("{m:.5}"));
         md.push_str(&format!(
-            "| {:.2} | {} | {} | {} | {} | {:.1} | {} | {:.1} |\n",
+            "| {:.2} | {} | {} | {} | {} | {:.1} | {:.0} | {} | {:.1} |\n",
             s.speed,
             if vr.is_empty() { "—".into() } else { vr.clone() },
             s.outcome(),
             if perf.is_empty() { "—".into() } else { perf.clone() },
             if mass.is_empty() { "—".into() } else { mass.clone() },
             s.end_time * 1e6,
+            s.fastest,
             s.steps,
             s.wall
         ));
         csv.push_str(&format!(
-            "{:.2},{vr},{},{},{perf},{mass},{:.3},{},{:.2},{}\n",
+            "{:.2},{vr},{},{},{perf},{mass},{:.3},{:.1},{},{:.2},{}\n",
             s.speed,
             s.perforated(),
             s.outcome().replace(',', ";"),
             s.end_time * 1e6,
+            s.fastest,
             s.steps,
             s.wall,
             s.dir.display()
@@ -631,7 +639,7 @@ pub fn table(study: &Study) -> (String, String) {
     }
     for (v, e) in &study.failures {
         md.push_str(&format!(
-            "| {v:.2} | — | failed: {} | | | | | |\n",
+            "| {v:.2} | — | failed: {} | | | | | | |\n",
             e.lines().next().unwrap_or("").replace('|', "/")
         ));
     }
@@ -809,6 +817,7 @@ mod tests {
             perforation: None,
             plug_mass: None,
             end_time: 0.0,
+            fastest: 0.0,
             steps: 0,
             wall: 0.0,
             dir: PathBuf::new(),

@@ -36,7 +36,9 @@ pub enum OutputError {
 /// [`crate::fracture`]), `exposed_slaves`, the particles that joined the
 /// contact slaves by exposure so far, and `exposed_contacts`, how many of
 /// them touched a rigid body in the last step (see
-/// [`crate::contact::ContactSystem::admit_exposed`]). Each rigid body `NAME` adds `NAME_x, NAME_y` (m), `NAME_vx, NAME_vy` (m/s),
+/// [`crate::contact::ContactSystem::admit_exposed`]), and
+/// `max_particle_speed`, the largest physical particle speed `max_I |v(X_I)|`
+/// at that step, m/s ([`crate::step::fastest_particle`]). Each rigid body `NAME` adds `NAME_x, NAME_y` (m), `NAME_vx, NAME_vy` (m/s),
 /// `NAME_fx, NAME_fy` (contact force on the body, N), `NAME_contacts` and
 /// `NAME_f_axial`, the contact force along its flight direction (the
 /// direction of its initial velocity; negative while braked; 0 for a body
@@ -59,6 +61,7 @@ pub const HISTORY_COLUMNS: &[&str] = &[
     "eroded_points",
     "exposed_slaves",
     "exposed_contacts",
+    "max_particle_speed",
 ];
 
 /// Columns of `cracks.csv`: one row per crack event; `particles` lists the
@@ -314,6 +317,7 @@ impl OutputWriter {
         let (admitted, touching) =
             sim.contact.as_ref().map_or((0, 0), |c| c.exposed_counts(&sim.model.particles.flags));
         row.extend([admitted as Real, touching as Real]);
+        row.push(crate::step::fastest_particle(&sim.model).0);
         if let Some(c) = &sim.contact {
             for b in 0..c.bodies.len() {
                 let s = c.sample(b).expect("body exists");

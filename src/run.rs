@@ -85,6 +85,8 @@ pub struct RunSummary {
     pub energies: crate::step::Energies,
     /// Largest |energy drift| seen at a history row.
     pub max_drift: Real,
+    /// The fastest particle of the run ([`crate::step::Simulation::fastest`]).
+    pub fastest: crate::step::FastestParticle,
     /// Estimated peak memory of the case, bytes
     /// ([`crate::memory::Footprint::bytes`]).
     pub memory_estimate: Real,
@@ -529,6 +531,7 @@ fn time_loop(
         stage_timers: sim.timers.list(),
         energies: sim.energies,
         max_drift: schedule.max_drift,
+        fastest: sim.fastest,
         memory_estimate: preflight(case)?.bytes(),
         peak_resident: crate::memory::peak_resident(),
         out_dir: cfg.out_dir.clone(),

@@ -191,6 +191,12 @@ impl Outcome {
         Some(if self.row.case.geometry == "axisymmetric" { plug.mass * 1e3 } else { plug.mass })
     }
 
+    /// The largest physical particle speed of the run, m/s
+    /// ([`crate::step::FastestParticle`]).
+    pub fn fastest(&self) -> Option<Real> {
+        Some(self.result.as_ref().ok()?.fastest.speed)
+    }
+
     /// First and last time (s) that particles admitted to the contact slaves
     /// by exposure touched the projectile (history rows), if they did
     /// ([`crate::contact::ContactSystem::admit_exposed`]).
@@ -253,10 +259,10 @@ fn material_label(case: &BorvikCase) -> &'static str {
 /// The table as Markdown and CSV.
 pub fn table(outcomes: &[Outcome]) -> (String, String) {
     let mut md = String::from(
-        "| case | geometry | discretization | criterion | material | particles | steps | wall (s) | residual (m/s) | experiment (m/s) | error % | [RL10] (m/s) | perforation (µs) | [RL10] perforation (µs) | plug mass (g; g/mm in plane strain) | plug velocity (m/s) | last contact (µs) | exposed contacts (µs) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| case | geometry | discretization | criterion | material | particles | steps | wall (s) | residual (m/s) | experiment (m/s) | error % | [RL10] (m/s) | perforation (µs) | [RL10] perforation (µs) | plug mass (g; g/mm in plane strain) | plug velocity (m/s) | last contact (µs) | exposed contacts (µs) | fastest particle (m/s) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let mut csv = String::from(
-        "row,case,geometry,discretization,criterion,material,particles,steps,wall_s,residual_m_s,experiment_m_s,error_percent,paper_m_s,perforation_us,paper_perforation_us,plug_mass,plug_velocity_m_s,last_contact_us,exposed_first_us,exposed_last_us,status\n",
+        "row,case,geometry,discretization,criterion,material,particles,steps,wall_s,residual_m_s,experiment_m_s,error_percent,paper_m_s,perforation_us,paper_perforation_us,plug_mass,plug_velocity_m_s,last_contact_us,exposed_first_us,exposed_last_us,fastest_particle_m_s,status\n",
     );
     for o in outcomes {
         let (r, c) = (&o.row, &o.row.case);
@@ -280,8 +286,9 @@ pub fn table(outcomes: &[Outcome]) -> (String, String) {
         let perforation = o.perforation().map(|t| t * 1e6);
         let last_contact = o.last_contact.map(|t| t * 1e6);
         let exposed = o.exposed_contacts();
+        let fastest = o.fastest();
         md.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {} | {:.1} | {} | {} | {} | {:.0} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {} | {:.1} | {} | {} | {} | {:.0} | {} | {} | {} | {} | {} |\n",
             r.experiment.name,
             c.geometry,
             c.discretization,
@@ -300,9 +307,10 @@ pub fn table(outcomes: &[Outcome]) -> (String, String) {
             fmt_opt(o.plug_speed(), 1),
             fmt_opt(last_contact, 1),
             exposed.map_or_else(|| "—".to_string(), |(a, b)| format!("{:.1}–{:.1}", a * 1e6, b * 1e6)),
+            fmt_opt(fastest, 0),
         ));
         csv.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{:.3},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             r.id,
             r.experiment.name,
             c.geometry,
@@ -323,6 +331,7 @@ pub fn table(outcomes: &[Outcome]) -> (String, String) {
             fmt_csv(last_contact, 3),
             fmt_csv(exposed.map(|e| e.0 * 1e6), 3),
             fmt_csv(exposed.map(|e| e.1 * 1e6), 3),
+            fmt_csv(fastest, 1),
             status.replace(',', ";"),
         ));
     }

@@ -513,10 +513,10 @@ fn fractured_points_carry_only_compression() {
     let tau0 = M3::new(3e8, 4e8, 0.0, 4e8, 3e8, 0.0, 0.0, 0.0, 1e8);
     let below = PointState { tau: tau0, eps_p: 0.5, eps_p_rate: 1e4, temperature: 400.0, damage: 0.2 };
     let own = jc.update(&below, &k);
-    assert_eq!(fractured(own), own, "intact points keep the model's update");
+    assert_eq!(fractured(own, 1.1), own, "intact points keep the model's update");
     let failed = PointState { damage: 1.0, ..below };
     let own = jc.update(&failed, &k);
-    let s = fractured(own);
+    let s = fractured(own, 1.01);
     assert!(own.tau.trace() > 0.0 && (own.tau - M3::identity() * own.tau.trace() / 3.0).norm() > 1e8);
     assert_eq!(s.tau, M3::zeros(), "no tension, no shear: {}", s.tau);
     assert_eq!((s.eps_p, s.temperature, s.damage), (own.eps_p, own.temperature, own.damage));
@@ -524,7 +524,54 @@ fn fractured_points_carry_only_compression() {
     let k_c = StepKinematics { d: M3::identity() * -1e5, w: M3::zeros(), dt: 1e-8 };
     let pressed = PointState { tau: M3::identity() * -5e8 + tau0 * 0.1, ..failed };
     let own = jc.update(&pressed, &k_c);
-    let s = fractured(own);
+    let s = fractured(own, 0.99);
     assert!((s.tau - M3::identity() * (own.tau.trace() / 3.0)).norm() < 1e-9 * own.tau.norm());
     assert!(s.tau.trace() < -1.0e9);
+}
+
+/// A fractured point carries pressure only while closed (`J < 1`;
+/// `plugsim::material::fractured`). The rate form alone measures pressure
+/// from the last state: a fractured point opened to `J = 1.16` (its
+/// tension dropped every step) and then squeezed back by 1 % would carry
+/// `K · 0.01 ≈ 1.7 GPa`, a spring that pushes and never pulls with its
+/// rest length at the largest stretch, which threw torn-off particles of
+/// the Borvik Case I up at 700 m/s. Driven through that cycle, the point
+/// carries nothing while open and the Kirchhoff pressure of its closure
+/// once `J < 1` (`K ln J` within a few per cent: only the part of the path
+/// below `J = 1` counts).
+#[test]
+fn open_fractured_material_does_not_push() {
+    let jc = weldox_460e();
+    let k_bulk = jc.bulk_modulus();
+    let dt = 1e-8;
+    let mut s = PointState { tau: M3::zeros(), eps_p: 1.0, eps_p_rate: 0.0, temperature: 293.0, damage: 1.0 };
+    let mut ln_j: f64 = 0.0;
+    // open to J = 1.16, close to J = 1.1484 (1 % squeeze), then to J = 0.98
+    let legs: [(f64, usize); 3] = [(1.16_f64.ln(), 100), ((1.16_f64 * 0.99).ln(), 10), (0.98_f64.ln(), 100)];
+    let mut squeezed_while_open = None;
+    for (target, n) in legs {
+        let rate = (target - ln_j) / (n as f64 * dt);
+        for _ in 0..n {
+            ln_j += rate * dt;
+            let d = M3::identity() * (rate / 3.0);
+            s = fractured(jc.update(&s, &StepKinematics { d, w: M3::zeros(), dt }), ln_j.exp());
+        }
+        if squeezed_while_open.is_none() && target < 1.16_f64.ln() && target > 0.0 {
+            squeezed_while_open = Some(s.tau);
+        }
+    }
+    assert_eq!(squeezed_while_open.unwrap(), M3::zeros(), "open material squeezed by 1 % pushes nothing");
+    let p = s.tau.trace() / 3.0;
+    let closed = k_bulk * 0.98_f64.ln();
+    assert!(
+        p < 0.0 && (p - closed).abs() < 0.05 * closed.abs(),
+        "closed to J = 0.98: {p:.4e} vs K ln J = {closed:.4e}"
+    );
+    // the rate form without the closure condition pushes in the squeeze
+    let mut s = PointState { tau: M3::zeros(), ..s };
+    let rate = (0.99_f64).ln() / (10.0 * dt);
+    for _ in 0..10 {
+        s = fractured(jc.update(&s, &StepKinematics { d: M3::identity() * (rate / 3.0), w: M3::zeros(), dt }), 0.999);
+    }
+    assert!(s.tau.trace() / 3.0 < -1.0e9, "closed material squeezed by 1 % pushes back: {:.3e}", s.tau.trace() / 3.0);
 }
