@@ -6,8 +6,9 @@
 use super::geometry::{
     left_bisector, left_normal, point_segment_distance, sector_angles, sector_contains, widest_empty_sector,
 };
+use super::nonlocal::NonlocalAverage;
 use super::visibility::{CrackSegments, CrackVisibility};
-use super::{Criterion, FractureError, FractureParameters};
+use super::{tip_speed, Criterion, FractureError, FractureParameters};
 use crate::geometry::GeometryMode;
 use crate::material::Constitutive;
 use crate::math::{Real, Tensor3, Vec2};
@@ -18,6 +19,7 @@ use crate::shape::ShapeTable;
 use crate::shape::{rebuild_rows, Basis};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
+use std::sync::OnceLock;
 
 /// Crack segments are extended by this many offsets `δ` beyond each end
 /// that is not a growing tip.
@@ -120,6 +122,9 @@ pub struct Crack {
     pub nucleated: (Real, u64),
     /// Arrest time, s, and step.
     pub arrested: Option<(Real, u64)>,
+    /// Distance the tip may still advance under the speed limit, m
+    /// ([`super::tip_speed`]; stays 0 without a limit).
+    pub allowance: Real,
 }
 
 impl Crack {
@@ -200,6 +205,13 @@ pub struct CrackGrowth {
     /// the copying itself. Scratch, not in checkpoints.
     #[serde(skip)]
     spare: Spare,
+    /// Time of the last stage, s: the speed limit's `Δt` ([`super::tip_speed`]).
+    last_time: Option<Real>,
+    /// The quadrature points binned for the non-local average (built at
+    /// its first use; the points never move in the reference
+    /// configuration). Not in checkpoints.
+    #[serde(skip)]
+    nonlocal: OnceLock<NonlocalAverage>,
 }
 
 /// See [`CrackGrowth::spare`].
@@ -266,6 +278,8 @@ impl CrackGrowth {
             reduced_quadrature_rows: BTreeMap::new(),
             reduced_particle_rows: BTreeMap::new(),
             spare: Spare::default(),
+            last_time: None,
+            nonlocal: OnceLock::new(),
         }
     }
 
@@ -285,6 +299,7 @@ impl CrackGrowth {
         let col = match self.params.criterion {
             Criterion::EffectiveStrain => &model.quad.eps_p,
             Criterion::Damage => &model.quad.damage,
+            Criterion::NonlocalDamage => return self.nonlocal_damage(model, i),
             Criterion::None => return 0.0,
         };
         let (mut acc, mut wsum) = (0.0, 0.0);
@@ -299,6 +314,17 @@ impl CrackGrowth {
         } else {
             0.0
         }
+    }
+
+    /// Johnson–Cook damage of particle `i` averaged over the material
+    /// length `nonlocal_radius` ([`super::nonlocal`]): the points of its
+    /// body within `ℓ` whose sight line to `X_i` crosses no crack.
+    pub fn nonlocal_damage(&self, model: &Model, i: usize) -> Real {
+        let q = &model.quad;
+        let av = self.nonlocal.get_or_init(|| NonlocalAverage::new(&q.x0, self.params.nonlocal_radius));
+        let (xi, body) = (model.particles.x0[i], model.particles.body[i]);
+        let area = |k: usize| q.weight[k] / model.mode.volume_factor(&q.x0[k]);
+        av.average(&xi, &q.x0, area, &q.damage, |k| q.body[k] == body && !self.segments.blocked(&xi, &q.x0[k]))
     }
 
     /// Stress triaxiality `σ_m / σ_eq` at particle `i`: the ratio of the
@@ -341,6 +367,8 @@ impl CrackGrowth {
         let Some(critical) = self.params.critical_value() else {
             return Ok(Vec::new());
         };
+        let dt = self.last_time.map_or(0.0, |t| time - t);
+        self.last_time = Some(time);
         let mut faces = Vec::new();
         for c in 0..self.cracks.len() {
             let Some(tip) = self.cracks[c].tip else {
@@ -384,12 +412,31 @@ impl CrackGrowth {
                 }
                 best = Some((value, j));
             }
+            if !self.tip_may_advance(model, c, best.map(|(_, j)| j), dt) {
+                continue;
+            }
             if let Some((value, j)) = best {
                 faces.extend(self.propagate(model, c, j, value, time, step)?);
             }
         }
         faces.extend(self.nucleate(model, critical, time, step)?);
         Ok(faces)
+    }
+
+    /// The speed limit's hook ([`super::tip_speed`]): whether the tip of
+    /// crack `c` may advance to `candidate` in a stage `dt` after the last,
+    /// updating its allowance. Always true without a limit.
+    fn tip_may_advance(&mut self, model: &Model, c: usize, candidate: Option<usize>, dt: Real) -> bool {
+        let tip = self.cracks[c].tip.expect("growing");
+        let m = &model.materials[model.particles.body[tip] as usize];
+        let Some(speed) = self.params.max_tip_speed(m.shear_modulus(), m.bulk_modulus(), m.density()) else {
+            return true;
+        };
+        let x = &model.particles.x0;
+        let distance = candidate.map(|j| (x[j] - x[tip]).norm());
+        let (go, allowance) = tip_speed::advance(self.cracks[c].allowance, speed, dt, distance);
+        self.cracks[c].allowance = allowance;
+        go
     }
 
     /// Insert a crack along the particles `path` (first: a surface
@@ -632,6 +679,7 @@ impl CrackGrowth {
             offset,
             nucleated: (time, step),
             arrested: None,
+            allowance: 0.0,
         });
         let split = Split { parent: i, vertex: xi, incoming: d, outgoing: d, reach: (xj - xi).norm(), offset };
         let (l, r) = self.split(model, id, split)?;

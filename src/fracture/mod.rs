@@ -185,6 +185,8 @@
 
 pub mod geometry;
 pub mod growth;
+pub mod nonlocal;
+pub mod tip_speed;
 pub mod visibility;
 
 pub use growth::{Crack, CrackEvent, CrackGrowth, CrackVertex, EventKind};
@@ -202,6 +204,11 @@ pub enum Criterion {
     EffectiveStrain,
     /// Johnson–Cook damage `D ≥ critical_damage`.
     Damage,
+    /// Johnson–Cook damage averaged over the material length
+    /// `nonlocal_radius` reaches 1 (the locus as it stands), with the crack
+    /// tip's speed limited to `crack_speed_fraction` × the Rayleigh wave
+    /// speed ([`nonlocal`], [`tip_speed`]; issue #19).
+    NonlocalDamage,
     /// No cracks.
     None,
 }
@@ -213,6 +220,23 @@ pub struct FractureParameters {
     /// `"effective_strain"`, `"damage"` or `"none"`. Default `"none"`, so
     /// cases written before fracture existed run unchanged.
     pub criterion: Criterion,
+    /// Interaction radius `ℓ` of the non-local damage average, m: the
+    /// bell-shaped weight `(1 − r²/ℓ²)²` vanishes at `r = ℓ` in the
+    /// reference configuration. A material length, independent of the
+    /// particle spacing. Default 1.0 mm ([`nonlocal`]). Read only by
+    /// `"nonlocal_damage"`.
+    pub nonlocal_radius: Real,
+    /// Largest crack-tip speed as a fraction of the Rayleigh wave speed of
+    /// the tip's material, dimensionless, in [0, 1]; 0 leaves the tip
+    /// unlimited ([RL10]'s jump of up to `R` per step). Default 1.0: no
+    /// crack outruns the Rayleigh wave ([`tip_speed`]). Read only by
+    /// `"nonlocal_damage"`.
+    pub crack_speed_fraction: Real,
+    /// With `"nonlocal_damage"`: whether a quadrature point whose own
+    /// damage reaches 1 keeps only compression
+    /// ([`crate::material::fractured`]), as with the per-particle criteria.
+    /// Default false ([`Self::fractures_points`]).
+    pub nonlocal_point_fracture: bool,
     /// Critical effective plastic strain ε_cr, dimensionless. Default 0.30
     /// ([RL10, §5]; reference/ren-li-2010.toml).
     pub critical_effective_strain: Real,
@@ -249,6 +273,9 @@ impl Default for FractureParameters {
     fn default() -> Self {
         FractureParameters {
             criterion: Criterion::None,
+            nonlocal_radius: 1.0e-3,
+            crack_speed_fraction: 1.0,
+            nonlocal_point_fracture: false,
             critical_effective_strain: 0.30,
             critical_damage: 0.50,
             radius_factor: 2.5,
@@ -272,6 +299,15 @@ impl FractureParameters {
         if !pos(self.critical_damage) {
             p.push(("critical_damage", format!("must be > 0, got {}", self.critical_damage)));
         }
+        if !pos(self.nonlocal_radius) {
+            p.push(("nonlocal_radius", format!("must be > 0 (m), got {}", self.nonlocal_radius)));
+        }
+        if !(self.crack_speed_fraction >= 0.0 && self.crack_speed_fraction <= 1.0) {
+            p.push((
+                "crack_speed_fraction",
+                format!("must lie in [0, 1] (0: unlimited), got {}", self.crack_speed_fraction),
+            ));
+        }
         if !(self.radius_factor >= 1.0 && self.radius_factor <= 5.0) {
             p.push(("radius_factor", format!("must lie in [1, 5] (local spacings), got {}", self.radius_factor)));
         }
@@ -288,12 +324,15 @@ impl FractureParameters {
     }
 
     /// Whether a quadrature point with plastic strain `eps_p` and damage
-    /// `damage` meets the crack criterion (false without one).
+    /// `damage` meets the crack criterion (false without one). With
+    /// `"nonlocal_damage"`: its own damage has reached 1 (the point has
+    /// failed by the locus; only the erosion of inverted points asks).
     #[inline]
     pub fn point_failed(&self, eps_p: Real, damage: Real) -> bool {
         match self.criterion {
             Criterion::EffectiveStrain => eps_p >= self.critical_effective_strain,
             Criterion::Damage => damage >= self.critical_damage,
+            Criterion::NonlocalDamage => damage >= nonlocal::CRITICAL_DAMAGE,
             Criterion::None => false,
         }
     }
@@ -303,8 +342,31 @@ impl FractureParameters {
         match self.criterion {
             Criterion::EffectiveStrain => Some(self.critical_effective_strain),
             Criterion::Damage => Some(self.critical_damage),
+            Criterion::NonlocalDamage => Some(nonlocal::CRITICAL_DAMAGE),
             Criterion::None => None,
         }
+    }
+
+    /// Whether a quadrature point whose own damage reaches 1 loses its
+    /// shear and tensile stress ([`crate::material::fractured`]) while
+    /// cracks grow: with the per-particle criteria, as before; not with
+    /// `"nonlocal_damage"`, where the failure is the crack's over the
+    /// material length and a point-wise stress drop would bring back the
+    /// mesh-size softening the average removes ([`nonlocal`]).
+    pub fn fractures_points(&self) -> bool {
+        match self.criterion {
+            Criterion::EffectiveStrain | Criterion::Damage => true,
+            Criterion::NonlocalDamage => self.nonlocal_point_fracture,
+            Criterion::None => false,
+        }
+    }
+
+    /// Largest crack-tip speed in a material with shear modulus `g`, bulk
+    /// modulus `k` and density `rho` (SI), m/s; `None`: unlimited (the
+    /// per-particle criteria, [RL10]'s jump, or `crack_speed_fraction = 0`).
+    pub fn max_tip_speed(&self, g: Real, k: Real, rho: Real) -> Option<Real> {
+        (self.criterion == Criterion::NonlocalDamage && self.crack_speed_fraction > 0.0)
+            .then(|| self.crack_speed_fraction * tip_speed::rayleigh_wave_speed(g, k, rho))
     }
 }
 
