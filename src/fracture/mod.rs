@@ -237,6 +237,14 @@ pub struct FractureParameters {
     /// ([`crate::material::fractured`]), as with the per-particle criteria.
     /// Default false ([`Self::fractures_points`]).
     pub nonlocal_point_fracture: bool,
+    /// With `"nonlocal_damage"`: the width `w` of the material's shear
+    /// band, m, if the crack is to follow the band's slip rather than the
+    /// average itself: a crack grows where `D̄ ≥ w / L`, `L = 5πℓ/16` the
+    /// width over which the bell weight averages a thin band
+    /// ([`nonlocal::band_critical_damage`]), i.e. where the damage
+    /// integrated across the band reaches that of a band of width `w` at
+    /// `D = 1`. Default none: `D̄ ≥ 1`.
+    pub band_width: Option<Real>,
     /// Critical effective plastic strain ε_cr, dimensionless. Default 0.30
     /// ([RL10, §5]; reference/ren-li-2010.toml).
     pub critical_effective_strain: Real,
@@ -276,6 +284,7 @@ impl Default for FractureParameters {
             nonlocal_radius: 1.0e-3,
             crack_speed_fraction: 1.0,
             nonlocal_point_fracture: false,
+            band_width: None,
             critical_effective_strain: 0.30,
             critical_damage: 0.50,
             radius_factor: 2.5,
@@ -307,6 +316,11 @@ impl FractureParameters {
                 "crack_speed_fraction",
                 format!("must lie in [0, 1] (0: unlimited), got {}", self.crack_speed_fraction),
             ));
+        }
+        if let Some(w) = self.band_width {
+            if !(pos(w) && w <= self.nonlocal_radius) {
+                p.push(("band_width", format!("must lie in (0, nonlocal_radius] (m), got {w}")));
+            }
         }
         if !(self.radius_factor >= 1.0 && self.radius_factor <= 5.0) {
             p.push(("radius_factor", format!("must lie in [1, 5] (local spacings), got {}", self.radius_factor)));
@@ -342,7 +356,10 @@ impl FractureParameters {
         match self.criterion {
             Criterion::EffectiveStrain => Some(self.critical_effective_strain),
             Criterion::Damage => Some(self.critical_damage),
-            Criterion::NonlocalDamage => Some(nonlocal::CRITICAL_DAMAGE),
+            Criterion::NonlocalDamage => Some(match self.band_width {
+                Some(w) => nonlocal::band_critical_damage(w, self.nonlocal_radius),
+                None => nonlocal::CRITICAL_DAMAGE,
+            }),
             Criterion::None => None,
         }
     }

@@ -59,6 +59,19 @@ use crate::neighbors::CellGrid;
 /// Crack at `D̄ ≥ 1`: the Johnson–Cook locus's own failure.
 pub const CRITICAL_DAMAGE: Real = 1.0;
 
+/// The width over which the bell weight averages a thin straight band
+/// through the centre, m: a band of width `w ≪ ℓ` at damage `D` averages
+/// to `D w / L` with `L = ∫α dA / ∫α ds = (πℓ²/3)/(16ℓ/15) = 5πℓ/16`.
+pub fn band_averaging_width(radius: Real) -> Real {
+    5.0 * std::f64::consts::PI * radius / 16.0
+}
+
+/// Critical average for a band of width `band_width`: `w / L`, at most 1
+/// (a band wider than `L` is averaged as a uniform field).
+pub fn band_critical_damage(band_width: Real, radius: Real) -> Real {
+    (band_width / band_averaging_width(radius)).min(CRITICAL_DAMAGE)
+}
+
 /// Bell weight `α(r) = (1 − r²/ℓ²)²` for `r < ℓ`, 0 beyond.
 #[inline]
 pub fn bell(r: Real, radius: Real) -> Real {
@@ -190,6 +203,23 @@ mod tests {
         assert!((coarse / fine - 1.0).abs() < 0.01, "{coarse} vs {fine}");
         // and not the point value: the band is narrower than ℓ
         assert!(fine < 0.8 * field(&x), "{fine} vs {}", field(&x));
+    }
+
+    /// A band one lattice row wide (`w = h`) at damage 2 through the
+    /// centre averages to `2 h / L`, `L = 5πℓ/16`.
+    #[test]
+    fn thin_band_averages_over_its_closed_form_width() {
+        let (h, l) = (0.02e-3, 1.0e-3);
+        let pts = lattice(h, 1.5e-3);
+        // the lattice row at y = h/2, seen from a point on it
+        let f: Vec<Real> = pts.iter().map(|p| if (p.y - 0.5 * h).abs() < 0.5 * h { 2.0 } else { 0.0 }).collect();
+        let av = NonlocalAverage::new(&pts, l);
+        let x = Vec2::new(0.01e-3, 0.5 * h);
+        let a = av.average(&x, &pts, |_| h * h, &f, |_| true);
+        let exact = 2.0 * h / band_averaging_width(l);
+        assert!((a / exact - 1.0).abs() < 0.01, "{a} vs {exact}");
+        assert_eq!(band_critical_damage(0.2e-3, l), 0.2e-3 / band_averaging_width(l));
+        assert_eq!(band_critical_damage(2e-3, l), 1.0);
     }
 
     #[test]
