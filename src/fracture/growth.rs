@@ -55,6 +55,23 @@ pub fn nodal_mass(model: &Model, i: usize) -> Real {
     rho * p.volume[i] * factor
 }
 
+/// The lumped projection of the quadrature values `col` at particle `i`,
+/// `Σ_q N_i(X_q) w_q c_q / Σ_q N_i(X_q) w_q` (0 without points).
+fn lumped_projection(model: &Model, i: usize, col: &[Real]) -> Real {
+    let (mut acc, mut wsum) = (0.0, 0.0);
+    for j in model.gather.range(i) {
+        let q = model.gather.point[j] as usize;
+        let w = model.gather.value[j] * model.quad.weight[q];
+        acc += w * col[q];
+        wsum += w;
+    }
+    if wsum != 0.0 {
+        acc / wsum
+    } else {
+        0.0
+    }
+}
+
 /// A segment may not pass within this fraction of a particle's spacing of
 /// a particle it does not end at.
 const PASS_OVER_FRACTION: Real = 0.1;
@@ -302,18 +319,7 @@ impl CrackGrowth {
             Criterion::NonlocalDamage => return self.nonlocal_damage(model, i),
             Criterion::None => return 0.0,
         };
-        let (mut acc, mut wsum) = (0.0, 0.0);
-        for j in model.gather.range(i) {
-            let q = model.gather.point[j] as usize;
-            let w = model.gather.value[j] * model.quad.weight[q];
-            acc += w * col[q];
-            wsum += w;
-        }
-        if wsum != 0.0 {
-            acc / wsum
-        } else {
-            0.0
-        }
+        lumped_projection(model, i, col)
     }
 
     /// Johnson–Cook damage of particle `i` averaged over the material
@@ -325,6 +331,19 @@ impl CrackGrowth {
         let (xi, body) = (model.particles.x0[i], model.particles.body[i]);
         let area = |k: usize| q.weight[k] / model.mode.volume_factor(&q.x0[k]);
         av.average(&xi, &q.x0, area, &q.damage, |k| q.body[k] == body && !self.segments.blocked(&xi, &q.x0[k]))
+    }
+
+    /// The value that ranks the candidates meeting the criterion, given
+    /// particle `i`'s criterion value `value`: the value itself, except
+    /// with `"nonlocal_damage"`, where it is the particle's own damage
+    /// (lumped projection): the average decides *whether* the band has
+    /// failed, the band's centre line — its most damaged particles —
+    /// *where* the crack runs (module doc of [`crate::fracture`]).
+    fn path_value(&self, model: &Model, i: usize, value: Real) -> Real {
+        if self.params.criterion != Criterion::NonlocalDamage {
+            return value;
+        }
+        lumped_projection(model, i, &model.quad.damage)
     }
 
     /// Stress triaxiality `σ_m / σ_eq` at particle `i`: the ratio of the
@@ -386,7 +405,8 @@ impl CrackGrowth {
                 continue;
             }
             let half_fan = 0.5 * self.params.fan_angle.to_radians();
-            let mut best: Option<(Real, usize)> = None;
+            // (path value, criterion value, particle)
+            let mut best: Option<(Real, Real, usize)> = None;
             for &j in &circle {
                 if model.particles.flags[j].has(ParticleFlags::CRACK_FACE) {
                     continue;
@@ -396,7 +416,8 @@ impl CrackGrowth {
                     continue;
                 }
                 let value = self.criterion_value(model, j);
-                if value < critical || best.is_some_and(|(bv, _)| bv >= value) {
+                let rank = self.path_value(model, j, value);
+                if value < critical || best.is_some_and(|(bv, _, _)| bv >= rank) {
                     continue;
                 }
                 if self.triaxiality(model, j) < NUCLEATION_MIN_TRIAXIALITY {
@@ -410,12 +431,12 @@ impl CrackGrowth {
                         continue;
                     }
                 }
-                best = Some((value, j));
+                best = Some((rank, value, j));
             }
-            if !self.tip_may_advance(model, c, best.map(|(_, j)| j), dt) {
+            if !self.tip_may_advance(model, c, best.map(|(_, _, j)| j), dt) {
                 continue;
             }
-            if let Some((value, j)) = best {
+            if let Some((_, value, j)) = best {
                 faces.extend(self.propagate(model, c, j, value, time, step)?);
             }
         }
@@ -579,14 +600,16 @@ impl CrackGrowth {
             if self.failed_zone_holds_a_crack(model, i, critical, &mut zones) {
                 continue;
             }
-            let mut best: Option<(Real, usize)> = None;
+            // (path value, criterion value, particle)
+            let mut best: Option<(Real, Real, usize)> = None;
             for j in self.circle(model, i) {
                 let f = model.particles.flags[j];
                 if f.has(ParticleFlags::CRACK_FACE) || f.has(ParticleFlags::SLAVE) || f.has(ParticleFlags::SURFACE) {
                     continue;
                 }
                 let value = self.criterion_value(model, j);
-                if value < critical || best.is_some_and(|(bv, _)| bv >= value) {
+                let rank = self.path_value(model, j, value);
+                if value < critical || best.is_some_and(|(bv, _, _)| bv >= rank) {
                     continue;
                 }
                 if self.triaxiality(model, j) < NUCLEATION_MIN_TRIAXIALITY {
@@ -600,9 +623,9 @@ impl CrackGrowth {
                 if inward.is_some_and(|n| angle(&(model.particles.x0[j] - xi), &n) > oblique) {
                     continue;
                 }
-                best = Some((value, j));
+                best = Some((rank, value, j));
             }
-            if let Some((value, j)) = best {
+            if let Some((_, value, j)) = best {
                 faces.extend(self.start_crack(model, i, j, value, time, step)?);
             }
         }
