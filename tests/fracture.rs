@@ -551,9 +551,19 @@ fn fracture_section_is_validated() {
         "fracture.fan_angle=200.0".to_string(),
         "fracture.offset_ratio=0.5".to_string(),
         "fracture.radius_factor=0.5".to_string(),
+        "fracture.nonlocal_radius=0.0".to_string(),
+        "fracture.crack_speed_fraction=1.5".to_string(),
     ];
     let err = Case::from_str_with(text, "f.toml", &sets).unwrap_err().to_string();
-    for key in ["critical_effective_strain", "fan_angle", "offset_ratio", "radius_factor"] {
+    let keys = [
+        "critical_effective_strain",
+        "fan_angle",
+        "offset_ratio",
+        "radius_factor",
+        "nonlocal_radius",
+        "crack_speed_fraction",
+    ];
+    for key in keys {
         assert!(err.contains(&format!("fracture.{key}")), "{key} not reported: {err}");
     }
     let unknown = Case::from_str_with(text, "f.toml", &["fracture.theta=1.0".to_string()]).unwrap_err().to_string();
@@ -561,6 +571,14 @@ fn fracture_section_is_validated() {
     let bad =
         Case::from_str_with(text, "f.toml", &["fracture.criterion=\"stress\"".to_string()]).unwrap_err().to_string();
     assert!(bad.contains("stress"), "{bad}");
+    // a band wider than the averaging length is refused; the non-local criterion parses
+    let wide = ["fracture.criterion=\"nonlocal_damage\"".to_string(), "fracture.band_width=2e-3".to_string()];
+    let err = Case::from_str_with(text, "f.toml", &wide).unwrap_err().to_string();
+    assert!(err.contains("fracture.band_width"), "{err}");
+    let ok = ["fracture.criterion=\"nonlocal_damage\"".to_string(), "fracture.band_width=0.2e-3".to_string()];
+    let case = Case::from_str_with(text, "f.toml", &ok).unwrap();
+    assert_eq!(case.fracture.criterion, Criterion::NonlocalDamage);
+    assert_eq!(case.fracture.band_width, Some(0.2e-3));
 }
 
 /// `time.stop_after_release`: a run that perforates ends once the
