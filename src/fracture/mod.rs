@@ -454,3 +454,29 @@ pub enum FractureError {
     #[error("crack path: {0}")]
     InvalidPath(String),
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Which criteria drop a point's stress at `D ≥ 1`, their critical
+    /// values, and which limit the tip's speed.
+    #[test]
+    fn nonlocal_criterion_switches() {
+        let nl = FractureParameters { criterion: Criterion::NonlocalDamage, ..FractureParameters::default() };
+        assert!(!nl.fractures_points());
+        assert!(FractureParameters { nonlocal_point_fracture: true, ..nl }.fractures_points());
+        for c in [Criterion::EffectiveStrain, Criterion::Damage] {
+            let p = FractureParameters { criterion: c, ..FractureParameters::default() };
+            assert!(p.fractures_points());
+            assert_eq!(p.max_tip_speed(80e9, 160e9, 7850.0), None, "{c:?}: [RL10]'s unlimited jump");
+        }
+        assert_eq!(nl.critical_value(), Some(1.0));
+        let band = FractureParameters { band_width: Some(0.2e-3), ..nl };
+        let l = 5.0 * std::f64::consts::PI * nl.nonlocal_radius / 16.0;
+        assert!((band.critical_value().unwrap() - 0.2e-3 / l).abs() < 1e-15);
+        let c = nl.max_tip_speed(80e9, 160e9, 7850.0).unwrap();
+        assert!(c > 0.87 * (80e9 / 7850.0_f64).sqrt() && c < (80e9 / 7850.0_f64).sqrt(), "{c}");
+        assert_eq!(FractureParameters { crack_speed_fraction: 0.0, ..nl }.max_tip_speed(80e9, 160e9, 7850.0), None);
+    }
+}
