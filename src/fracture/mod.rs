@@ -219,8 +219,8 @@
 //!   stands) leaves Case I 24 % slow and Case II unperforated; the band
 //!   criterion with `ℓ = 1 mm`, `w = 0.2 mm` gives Case I 243.5, 246.1,
 //!   246.3 m/s at 12, 24, 48 rows (measured 241.4) and Case II 128.1,
-//!   131.2, 133.6 m/s (measured 112.0), hence an option, not the
-//!   default. `D̄ ≥ 1` runs needed `time.safety_factor = 0.25`: a split
+//!   131.2, 133.6 m/s (measured 112.0), and Case II's ballistic limit
+//!   122 and 147 m/s at 12 and 24 rows: an option, not the default. `D̄ ≥ 1` runs needed `time.safety_factor = 0.25`: a split
 //!   in material that still carries stress (the tip runs into stressed
 //!   material, where [RL10]'s criteria run into points already reduced to
 //!   pressure) threw particles off at 0.5 (coarse Case I at 17.6 µs with

@@ -56,7 +56,8 @@
 //! (quoted from memory, not checked here). What `ℓ` and `w` give is in
 //! `docs/validation.md` ("Fracture models over a length"): with both,
 //! Case I converges (12, 24, 48 rows within 1.2 %) and lands within
-//! +2 % of the experiment; Case II is over-predicted by 14–19 %.
+//! +2 % of the experiment; Case II is over-predicted by 14–19 % and its
+//! ballistic limit does not converge (122 and 147 m/s at 12 and 24 rows).
 //!
 //! Tests (independent answers): the unnormalised weight's sum over a
 //! lattice's points equals `∫ α dA = π ℓ²/3` at two spacings; a constant
