@@ -475,6 +475,8 @@ impl Simulation {
         let cracking = self.cracks.as_ref().is_some_and(|c| c.params.critical_value().is_some());
         // Erosion of inverted failed points (`crate::fracture` module doc).
         let erosion = self.cracks.as_ref().map(|c| c.params).filter(|p| cracking && p.erode_inverted);
+        // Not with the non-local criterion (`FractureParameters::fractures_points`).
+        let fracturing = cracking && self.cracks.as_ref().is_some_and(|c| c.params.fractures_points());
         // One increment per point (a simulation read from a checkpoint
         // starts with none).
         self.work_scratch.resize(self.model.quad.len(), 0.0);
@@ -529,7 +531,7 @@ impl Simulation {
                 damage: c.damage[k],
             };
             let new = mats[body as usize].update(&old, &StepKinematics { d: kin.d, w: kin.w, dt });
-            let new = if cracking { crate::material::fractured(new, J) } else { new };
+            let new = if fracturing { crate::material::fractured(new, J) } else { new };
             // Block-form kinematics keep a block-form stress (the models'
             // updates are sums and block products of `τ`, `d` and `w`).
             debug_assert!(is_block_2d(&new.tau), "material update left the block form at point {qi}");

@@ -299,6 +299,7 @@ fn crack_state_round_trips_bit_for_bit() {
         offset: 1e-6,
         nucleated: (-0.0, 1),
         arrested: Some((2e-9, 2)),
+        allowance: 3.5e-5,
     });
     let again = dir.join("odd.ckpt");
     checkpoint::write(&again, &restored.sim, &restored.case, &restored.progress).unwrap();
@@ -391,20 +392,20 @@ fn checkpoint_of_another_format_version_is_refused_naming_both() {
     }
 }
 
-/// Format 3 (the last hand-written one, before the state was serialized
-/// with serde and postcard) is refused, naming both versions, rather than
+/// Format 4 (postcard, before the fastest particle, the crack-tip
+/// allowance and the non-local fracture parameters) is refused, naming both versions, rather than
 /// misread.
 #[test]
 fn older_format_version_checkpoint_is_refused_naming_both_versions() {
-    assert_eq!(FORMAT_VERSION, 5);
+    assert_eq!(FORMAT_VERSION, 6);
     let case = case(STRIKE, &["time.end=1e-6"]);
-    let dir = scratch("version-3");
+    let dir = scratch("version-4");
     let path = run_until(&case, &dir, 2);
-    corrupt(&path, 8, &3u32.to_le_bytes());
+    corrupt(&path, 8, &4u32.to_le_bytes());
     let e = checkpoint::read(&path).unwrap_err().to_string();
-    assert!(e.contains("format version 3 ") && e.contains("reads format version 5"), "{e}");
+    assert!(e.contains("format version 4 ") && e.contains("reads format version 6"), "{e}");
     let e = resume(&config(&dir, None), &mut |_| {}).unwrap_err().to_string();
-    assert!(e.contains("format version 3 ") && e.contains("format version 5"), "{e}");
+    assert!(e.contains("format version 4 ") && e.contains("format version 6"), "{e}");
 }
 
 #[test]

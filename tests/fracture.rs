@@ -551,9 +551,19 @@ fn fracture_section_is_validated() {
         "fracture.fan_angle=200.0".to_string(),
         "fracture.offset_ratio=0.5".to_string(),
         "fracture.radius_factor=0.5".to_string(),
+        "fracture.nonlocal_radius=0.0".to_string(),
+        "fracture.crack_speed_fraction=1.5".to_string(),
     ];
     let err = Case::from_str_with(text, "f.toml", &sets).unwrap_err().to_string();
-    for key in ["critical_effective_strain", "fan_angle", "offset_ratio", "radius_factor"] {
+    let keys = [
+        "critical_effective_strain",
+        "fan_angle",
+        "offset_ratio",
+        "radius_factor",
+        "nonlocal_radius",
+        "crack_speed_fraction",
+    ];
+    for key in keys {
         assert!(err.contains(&format!("fracture.{key}")), "{key} not reported: {err}");
     }
     let unknown = Case::from_str_with(text, "f.toml", &["fracture.theta=1.0".to_string()]).unwrap_err().to_string();
@@ -561,6 +571,14 @@ fn fracture_section_is_validated() {
     let bad =
         Case::from_str_with(text, "f.toml", &["fracture.criterion=\"stress\"".to_string()]).unwrap_err().to_string();
     assert!(bad.contains("stress"), "{bad}");
+    // a band wider than the averaging length is refused; the non-local criterion parses
+    let wide = ["fracture.criterion=\"nonlocal_damage\"".to_string(), "fracture.band_width=2e-3".to_string()];
+    let err = Case::from_str_with(text, "f.toml", &wide).unwrap_err().to_string();
+    assert!(err.contains("fracture.band_width"), "{err}");
+    let ok = ["fracture.criterion=\"nonlocal_damage\"".to_string(), "fracture.band_width=0.2e-3".to_string()];
+    let case = Case::from_str_with(text, "f.toml", &ok).unwrap();
+    assert_eq!(case.fracture.criterion, Criterion::NonlocalDamage);
+    assert_eq!(case.fracture.band_width, Some(0.2e-3));
 }
 
 /// `time.stop_after_release`: a run that perforates ends once the
@@ -713,4 +731,61 @@ fn inverted_failed_points_are_eroded_and_others_stop_the_run() {
     // Erosion off: the run stops even where the points failed.
     let x = inverted(&mut setup(0.5, false));
     assert!((x - centre).norm() < 3.5 * H, "{x:?}");
+}
+
+/// The crack-tip speed limit of `"nonlocal_damage"` (`fracture::tip_speed`):
+/// a column of material failed everywhere (Johnson–Cook damage 5) down a
+/// tall plate. Limited to the Rayleigh speed `c_R`, the tip's path after
+/// nucleation is at most `c_R (t − t_n)` and trails it by less than one
+/// advance (`R`); unlimited (`crack_speed_fraction = 0`, [RL10]'s jump),
+/// it advances one particle per stage.
+#[test]
+fn crack_tip_advances_at_the_prescribed_speed() {
+    let (nx, ny) = (11, 41);
+    let dt = 4.0e-8;
+    let run = |fraction: Real| {
+        let mut m = plate(nx, ny);
+        for q in 0..m.quad.len() {
+            m.quad.damage[q] = if (m.quad.x0[q].x - 5.0 * H).abs() < 0.6 * H { 5.0 } else { 0.0 };
+        }
+        let p = FractureParameters {
+            nonlocal_radius: 0.8 * H,
+            crack_speed_fraction: fraction,
+            ..params(Criterion::NonlocalDamage)
+        };
+        let mut g = CrackGrowth::new(p);
+        let mut track = Vec::new();
+        for step in 1..=400u64 {
+            g.grow(&mut m, step as Real * dt, step).unwrap();
+            let Some(c) = g.cracks.first() else { continue };
+            if c.arrested.is_some() {
+                break;
+            }
+            let v = &c.vertices;
+            let path: Real = v.windows(2).skip(1).map(|w| (w[1].x0 - w[0].x0).norm()).sum();
+            track.push((step as Real * dt - c.nucleated.0, path, m.particles.x0[c.tip.unwrap()].x));
+        }
+        (g, track)
+    };
+    let mat = steel();
+    let nu = mat.poisson_ratio;
+    let (gm, km) = (mat.youngs_modulus / (2.0 * (1.0 + nu)), mat.youngs_modulus / (3.0 * (1.0 - 2.0 * nu)));
+    let c_r = plugsim::fracture::tip_speed::rayleigh_wave_speed(gm, km, mat.density);
+    // Viktorov's approximation, within 0.5 %
+    let viktorov = (0.862 + 1.14 * nu) / (1.0 + nu) * (gm / mat.density).sqrt();
+    assert!((c_r / viktorov - 1.0).abs() < 5e-3, "c_R of steel: {c_r} vs {viktorov}");
+    let (g, track) = run(1.0);
+    assert_eq!(g.cracks.len(), 1);
+    assert!(track.len() > 100, "grew over {} stages", track.len());
+    let advances = g.events.iter().filter(|e| e.kind == EventKind::Propagate).count();
+    assert!(advances >= 15, "{advances} advances");
+    for &(t, path, x) in &track {
+        assert!((x - 5.0 * H).abs() < 1e-9, "straight down the failed column: x = {x}");
+        assert!(path <= c_r * t + 1e-9 * H, "ahead of c_R t: {path} > {}", c_r * t);
+        assert!(path > c_r * t - 2.5 * H, "behind c_R t by more than R: {path} vs {}", c_r * t);
+    }
+    // unlimited: one particle per stage
+    let (g, track) = run(0.0);
+    let advances = g.events.iter().filter(|e| e.kind == EventKind::Propagate).count();
+    assert!(advances >= 30 && track.len() <= advances + 1, "{advances} advances in {} stages", track.len());
 }

@@ -6,8 +6,9 @@
 use super::geometry::{
     left_bisector, left_normal, point_segment_distance, sector_angles, sector_contains, widest_empty_sector,
 };
+use super::nonlocal::NonlocalAverage;
 use super::visibility::{CrackSegments, CrackVisibility};
-use super::{Criterion, FractureError, FractureParameters};
+use super::{tip_speed, Criterion, FractureError, FractureParameters};
 use crate::geometry::GeometryMode;
 use crate::material::Constitutive;
 use crate::math::{Real, Tensor3, Vec2};
@@ -18,6 +19,7 @@ use crate::shape::ShapeTable;
 use crate::shape::{rebuild_rows, Basis};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
+use std::sync::OnceLock;
 
 /// Crack segments are extended by this many offsets `δ` beyond each end
 /// that is not a growing tip.
@@ -51,6 +53,23 @@ pub fn nodal_mass(model: &Model, i: usize) -> Real {
         GeometryMode::Axisymmetric => model.mode.volume_factor(&Vec2::new(x.x.max(0.25 * p.spacing[i]), x.y)),
     };
     rho * p.volume[i] * factor
+}
+
+/// The lumped projection of the quadrature values `col` at particle `i`,
+/// `Σ_q N_i(X_q) w_q c_q / Σ_q N_i(X_q) w_q` (0 without points).
+fn lumped_projection(model: &Model, i: usize, col: &[Real]) -> Real {
+    let (mut acc, mut wsum) = (0.0, 0.0);
+    for j in model.gather.range(i) {
+        let q = model.gather.point[j] as usize;
+        let w = model.gather.value[j] * model.quad.weight[q];
+        acc += w * col[q];
+        wsum += w;
+    }
+    if wsum != 0.0 {
+        acc / wsum
+    } else {
+        0.0
+    }
 }
 
 /// A segment may not pass within this fraction of a particle's spacing of
@@ -120,6 +139,9 @@ pub struct Crack {
     pub nucleated: (Real, u64),
     /// Arrest time, s, and step.
     pub arrested: Option<(Real, u64)>,
+    /// Distance the tip may still advance under the speed limit, m
+    /// ([`super::tip_speed`]; stays 0 without a limit).
+    pub allowance: Real,
 }
 
 impl Crack {
@@ -200,6 +222,13 @@ pub struct CrackGrowth {
     /// the copying itself. Scratch, not in checkpoints.
     #[serde(skip)]
     spare: Spare,
+    /// Time of the last stage, s: the speed limit's `Δt` ([`super::tip_speed`]).
+    last_time: Option<Real>,
+    /// The quadrature points binned for the non-local average (built at
+    /// its first use; the points never move in the reference
+    /// configuration). Not in checkpoints.
+    #[serde(skip)]
+    nonlocal: OnceLock<NonlocalAverage>,
 }
 
 /// See [`CrackGrowth::spare`].
@@ -266,6 +295,8 @@ impl CrackGrowth {
             reduced_quadrature_rows: BTreeMap::new(),
             reduced_particle_rows: BTreeMap::new(),
             spare: Spare::default(),
+            last_time: None,
+            nonlocal: OnceLock::new(),
         }
     }
 
@@ -285,20 +316,34 @@ impl CrackGrowth {
         let col = match self.params.criterion {
             Criterion::EffectiveStrain => &model.quad.eps_p,
             Criterion::Damage => &model.quad.damage,
+            Criterion::NonlocalDamage => return self.nonlocal_damage(model, i),
             Criterion::None => return 0.0,
         };
-        let (mut acc, mut wsum) = (0.0, 0.0);
-        for j in model.gather.range(i) {
-            let q = model.gather.point[j] as usize;
-            let w = model.gather.value[j] * model.quad.weight[q];
-            acc += w * col[q];
-            wsum += w;
+        lumped_projection(model, i, col)
+    }
+
+    /// Johnson–Cook damage of particle `i` averaged over the material
+    /// length `nonlocal_radius` ([`super::nonlocal`]): the points of its
+    /// body within `ℓ` whose sight line to `X_i` crosses no crack.
+    pub fn nonlocal_damage(&self, model: &Model, i: usize) -> Real {
+        let q = &model.quad;
+        let av = self.nonlocal.get_or_init(|| NonlocalAverage::new(&q.x0, self.params.nonlocal_radius));
+        let (xi, body) = (model.particles.x0[i], model.particles.body[i]);
+        let area = |k: usize| q.weight[k] / model.mode.volume_factor(&q.x0[k]);
+        av.average(&xi, &q.x0, area, &q.damage, |k| q.body[k] == body && !self.segments.blocked(&xi, &q.x0[k]))
+    }
+
+    /// The value that ranks the candidates meeting the criterion, given
+    /// particle `i`'s criterion value `value`: the value itself, except
+    /// with `"nonlocal_damage"`, where it is the particle's own damage
+    /// (lumped projection): the average decides *whether* the band has
+    /// failed, the band's centre line — its most damaged particles —
+    /// *where* the crack runs (module doc of [`crate::fracture`]).
+    fn path_value(&self, model: &Model, i: usize, value: Real) -> Real {
+        if self.params.criterion != Criterion::NonlocalDamage {
+            return value;
         }
-        if wsum != 0.0 {
-            acc / wsum
-        } else {
-            0.0
-        }
+        lumped_projection(model, i, &model.quad.damage)
     }
 
     /// Stress triaxiality `σ_m / σ_eq` at particle `i`: the ratio of the
@@ -341,6 +386,8 @@ impl CrackGrowth {
         let Some(critical) = self.params.critical_value() else {
             return Ok(Vec::new());
         };
+        let dt = self.last_time.map_or(0.0, |t| time - t);
+        self.last_time = Some(time);
         let mut faces = Vec::new();
         for c in 0..self.cracks.len() {
             let Some(tip) = self.cracks[c].tip else {
@@ -358,7 +405,8 @@ impl CrackGrowth {
                 continue;
             }
             let half_fan = 0.5 * self.params.fan_angle.to_radians();
-            let mut best: Option<(Real, usize)> = None;
+            // (path value, criterion value, particle)
+            let mut best: Option<(Real, Real, usize)> = None;
             for &j in &circle {
                 if model.particles.flags[j].has(ParticleFlags::CRACK_FACE) {
                     continue;
@@ -368,7 +416,8 @@ impl CrackGrowth {
                     continue;
                 }
                 let value = self.criterion_value(model, j);
-                if value < critical || best.is_some_and(|(bv, _)| bv >= value) {
+                let rank = self.path_value(model, j, value);
+                if value < critical || best.is_some_and(|(bv, _, _)| bv >= rank) {
                     continue;
                 }
                 if self.triaxiality(model, j) < NUCLEATION_MIN_TRIAXIALITY {
@@ -382,14 +431,33 @@ impl CrackGrowth {
                         continue;
                     }
                 }
-                best = Some((value, j));
+                best = Some((rank, value, j));
             }
-            if let Some((value, j)) = best {
+            if !self.tip_may_advance(model, c, best.map(|(_, _, j)| j), dt) {
+                continue;
+            }
+            if let Some((_, value, j)) = best {
                 faces.extend(self.propagate(model, c, j, value, time, step)?);
             }
         }
         faces.extend(self.nucleate(model, critical, time, step)?);
         Ok(faces)
+    }
+
+    /// The speed limit's hook ([`super::tip_speed`]): whether the tip of
+    /// crack `c` may advance to `candidate` in a stage `dt` after the last,
+    /// updating its allowance. Always true without a limit.
+    fn tip_may_advance(&mut self, model: &Model, c: usize, candidate: Option<usize>, dt: Real) -> bool {
+        let tip = self.cracks[c].tip.expect("growing");
+        let m = &model.materials[model.particles.body[tip] as usize];
+        let Some(speed) = self.params.max_tip_speed(m.shear_modulus(), m.bulk_modulus(), m.density()) else {
+            return true;
+        };
+        let x = &model.particles.x0;
+        let distance = candidate.map(|j| (x[j] - x[tip]).norm());
+        let (go, allowance) = tip_speed::advance(self.cracks[c].allowance, speed, dt, distance);
+        self.cracks[c].allowance = allowance;
+        go
     }
 
     /// Insert a crack along the particles `path` (first: a surface
@@ -532,14 +600,16 @@ impl CrackGrowth {
             if self.failed_zone_holds_a_crack(model, i, critical, &mut zones) {
                 continue;
             }
-            let mut best: Option<(Real, usize)> = None;
+            // (path value, criterion value, particle)
+            let mut best: Option<(Real, Real, usize)> = None;
             for j in self.circle(model, i) {
                 let f = model.particles.flags[j];
                 if f.has(ParticleFlags::CRACK_FACE) || f.has(ParticleFlags::SLAVE) || f.has(ParticleFlags::SURFACE) {
                     continue;
                 }
                 let value = self.criterion_value(model, j);
-                if value < critical || best.is_some_and(|(bv, _)| bv >= value) {
+                let rank = self.path_value(model, j, value);
+                if value < critical || best.is_some_and(|(bv, _, _)| bv >= rank) {
                     continue;
                 }
                 if self.triaxiality(model, j) < NUCLEATION_MIN_TRIAXIALITY {
@@ -553,9 +623,9 @@ impl CrackGrowth {
                 if inward.is_some_and(|n| angle(&(model.particles.x0[j] - xi), &n) > oblique) {
                     continue;
                 }
-                best = Some((value, j));
+                best = Some((rank, value, j));
             }
-            if let Some((value, j)) = best {
+            if let Some((_, value, j)) = best {
                 faces.extend(self.start_crack(model, i, j, value, time, step)?);
             }
         }
@@ -632,6 +702,7 @@ impl CrackGrowth {
             offset,
             nucleated: (time, step),
             arrested: None,
+            allowance: 0.0,
         });
         let split = Split { parent: i, vertex: xi, incoming: d, outgoing: d, reach: (xj - xi).norm(), offset };
         let (l, r) = self.split(model, id, split)?;

@@ -93,7 +93,9 @@ pub trait Constitutive {
 /// is element erosion at `D = 1` in LS-DYNA's and Abaqus's Johnson–Cook
 /// failure, here without deleting the point (the crack algorithm decides
 /// where the body separates). The solver applies it to every point's
-/// update while crack growth is on (`Simulation::update_material`); the
+/// update while crack growth is on (`Simulation::update_material`), except
+/// with the non-local criterion unless asked
+/// (`FractureParameters::fractures_points`); the
 /// models and the material-point driver stay the models of SPEC §6.
 ///
 /// # Deviations

@@ -1,0 +1,249 @@
+//! Non-local Johnson–Cook damage: the crack criterion of
+//! `criterion = "nonlocal_damage"` (issue #19; deviation from SPEC §9,
+//! which tests `ε̄` or `D` at one particle).
+//!
+//! Each quadrature point integrates the Johnson–Cook damage of SPEC §6,
+//! `D = Σ Δε̄ / ε_f(σ*, ε̇*, T*)`, with the locus of the material (for
+//! Weldox 460 E `D₁ + D₂ ≈ 1.80` at zero triaxiality, 1.52 in uniaxial
+//! tension). The value of particle `I` is the average over the quadrature
+//! points `q` of its body within the **material length** `ℓ`
+//! (`nonlocal_radius`) in the reference configuration, with the bell
+//! weight of Bažant and Jirásek (2002),
+//!
+//! `D̄_I = Σ_q α(|X_q − X_I|) A_q D_q / Σ_q α(|X_q − X_I|) A_q`,
+//! `α(r) = (1 − r²/ℓ²)²` for `r < ℓ`, 0 beyond,
+//!
+//! `A_q` the point's area in the section (its weight without the `2πR`
+//! of axisymmetry). A point whose sight line to `X_I` crosses a crack
+//! segment is left out (the material across a crack is another body's).
+//! A crack grows where `D̄ ≥ 1` — the locus as it stands, no critical
+//! value fitted to ballistic results ([`CRITICAL_DAMAGE`]) — or, with a
+//! band width `w` (`band_width`), where `D̄ ≥ w/L`
+//! ([`band_critical_damage`]): a band of width `w ≪ ℓ` at damage `D`
+//! averages to `D w/L`, `L = 5πℓ/16` ([`band_averaging_width`]), so the
+//! criterion asks the damage integrated across the band, `∫ D dn`, to
+//! reach `w` — the slip of a band of the material's width at `D = 1`,
+//! however many rows the discretized band spreads over, as long as `ℓ`
+//! covers it.
+//!
+//! Why an average: the Johnson–Cook model has no length, and the shear
+//! band under the projectile's corner is as narrow as the discretization
+//! allows (heat conduction's length, `√(κ t) ≈ 17 µm` at 20 µs, is far
+//! below any spacing here). The damage at one particle therefore grows
+//! faster on a finer lattice, and the per-particle criteria crack sooner
+//! there (Case II, axisymmetric, `D ≥ 0.5`: not perforated coarse,
+//! perforated fine). Averaged over `ℓ` wider than the band, `D̄` measures
+//! the band's integral, `∫ D dn / ℓ` across it — the slip across the band
+//! over `ℓ` weighted by the locus — which converges with the slip.
+//!
+//! **Why the average weights areas, not volumes, in axisymmetry** (and how
+//! it carries to 3D): in 3D the average is over a ball of radius `ℓ`. A
+//! field that does not vary along the hoop direction, averaged in 3D with
+//! the separable Gaussian-like weight about a point at radius `R ≫ ℓ`, is
+//! the 2D average in the r-z section with the same weight and plane areas
+//! (the hoop integral is the same for every point of the section). The
+//! weight table is then a 3D neighbour list over Gauss points within `ℓ`,
+//! cut by crack surfaces instead of segments (a sight line crossing a
+//! crack triangle); `ℓ` and the locus are unchanged.
+//!
+//! **`ℓ` and `w`.** `ℓ` (default 1.0 mm) is an averaging length, not
+//! the band's: it must cover the band the coarsest lattice forms (about
+//! two spacings, 0.9 mm at 24 rows through Case I's 11.1 mm); with
+//! `ℓ = 0.5 mm` the 24-row band is wider than `L = 0.49 mm` and Case I
+//! moves by 5 %. `w` is the material's band width; 0.2 mm was set before
+//! any run as the order of the shear band in Børvik's plugged Weldox
+//! 460 E plates and of the element size Børvik et al. resolved it with
+//! (quoted from memory, not checked here). What `ℓ` and `w` give is in
+//! `docs/validation.md` ("Fracture models over a length"): with both,
+//! Case I converges (12, 24, 48 rows within 1.2 %) and lands within
+//! +2 % of the experiment; Case II is over-predicted by 14–19 % and its
+//! ballistic limit does not converge (122 and 147 m/s at 12 and 24 rows).
+//!
+//! Tests (independent answers): the unnormalised weight's sum over a
+//! lattice's points equals `∫ α dA = π ℓ²/3` at two spacings; a constant
+//! field is kept exactly and a linear field gives its value at the centre;
+//! a smooth field's average is the same at two spacings; a crack cuts the
+//! average.
+
+use crate::math::{Real, Vec2};
+use crate::neighbors::CellGrid;
+
+/// Crack at `D̄ ≥ 1`: the Johnson–Cook locus's own failure.
+pub const CRITICAL_DAMAGE: Real = 1.0;
+
+/// The width over which the bell weight averages a thin straight band
+/// through the centre, m: a band of width `w ≪ ℓ` at damage `D` averages
+/// to `D w / L` with `L = ∫α dA / ∫α ds = (πℓ²/3)/(16ℓ/15) = 5πℓ/16`.
+pub fn band_averaging_width(radius: Real) -> Real {
+    5.0 * std::f64::consts::PI * radius / 16.0
+}
+
+/// Critical average for a band of width `band_width`: `w / L`, at most 1
+/// (a band wider than `L` is averaged as a uniform field).
+pub fn band_critical_damage(band_width: Real, radius: Real) -> Real {
+    (band_width / band_averaging_width(radius)).min(CRITICAL_DAMAGE)
+}
+
+/// Bell weight `α(r) = (1 − r²/ℓ²)²` for `r < ℓ`, 0 beyond.
+#[inline]
+pub fn bell(r: Real, radius: Real) -> Real {
+    if r >= radius {
+        0.0
+    } else {
+        let s = 1.0 - (r / radius).powi(2);
+        s * s
+    }
+}
+
+/// Quadrature points binned for the averages over `radius`.
+#[derive(Clone, Debug)]
+pub struct NonlocalAverage {
+    /// `ℓ`, m.
+    pub radius: Real,
+    grid: CellGrid,
+}
+
+impl NonlocalAverage {
+    /// Bin the points `x0` (reference positions) in cells of `radius`.
+    pub fn new(x0: &[Vec2], radius: Real) -> Self {
+        NonlocalAverage { radius, grid: CellGrid::new(x0, radius) }
+    }
+
+    /// `(Σ α A f, Σ α A)` over the points `q` within `ℓ` of `x` for which
+    /// `include(q)`, with areas `area(q)` and values `f[q]`.
+    pub fn sums(
+        &self,
+        x: &Vec2,
+        x0: &[Vec2],
+        area: impl Fn(usize) -> Real,
+        f: &[Real],
+        include: impl Fn(usize) -> bool,
+    ) -> (Real, Real) {
+        let (mut acc, mut wsum) = (0.0, 0.0);
+        self.grid.for_each_candidate(x, self.radius, |q| {
+            let a = bell((x0[q] - x).norm(), self.radius);
+            if a > 0.0 && include(q) {
+                let w = a * area(q);
+                acc += w * f[q];
+                wsum += w;
+            }
+        });
+        (acc, wsum)
+    }
+
+    /// The average `Σ α A f / Σ α A` (0 where no point counts).
+    pub fn average(
+        &self,
+        x: &Vec2,
+        x0: &[Vec2],
+        area: impl Fn(usize) -> Real,
+        f: &[Real],
+        include: impl Fn(usize) -> bool,
+    ) -> Real {
+        let (acc, wsum) = self.sums(x, x0, area, f, include);
+        if wsum > 0.0 {
+            acc / wsum
+        } else {
+            0.0
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    /// Cell centres of a uniform lattice of spacing `h` over `[−w, w]²`.
+    fn lattice(h: Real, w: Real) -> Vec<Vec2> {
+        let n = (2.0 * w / h).round() as i64;
+        let mut out = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                out.push(Vec2::new(-w + (i as Real + 0.5) * h, -w + (j as Real + 0.5) * h));
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn weight_integrates_to_its_closed_form_at_two_spacings() {
+        let l = 1.0e-3;
+        // ∫ (1 − r²/ℓ²)² 2πr dr over [0, ℓ] = π ℓ²/3.
+        let exact = PI * l * l / 3.0;
+        for h in [0.2e-3, 0.1e-3] {
+            let pts = lattice(h, 3e-3);
+            let av = NonlocalAverage::new(&pts, l);
+            let x = Vec2::new(0.03e-3, -0.07e-3);
+            let ones = vec![1.0; pts.len()];
+            let (_, w) = av.sums(&x, &pts, |_| h * h, &ones, |_| true);
+            let err = (w / exact - 1.0).abs();
+            assert!(err < 0.02 * (h / 0.1e-3).powi(2), "h = {h}: {w} vs {exact} ({err:.2e})");
+        }
+    }
+
+    #[test]
+    fn constant_is_kept_and_linear_field_gives_the_centre_value() {
+        let (h, l) = (0.1e-3, 0.45e-3);
+        let pts = lattice(h, 2e-3);
+        let av = NonlocalAverage::new(&pts, l);
+        let c = vec![0.7; pts.len()];
+        // An interior lattice point (a cell corner): the points within ℓ
+        // are symmetric about it.
+        let x = Vec2::new(0.3e-3, -0.2e-3);
+        let a = av.average(&x, &pts, |_| h * h, &c, |_| true);
+        assert!((a - 0.7).abs() < 1e-14, "{a}");
+        let lin: Vec<Real> = pts.iter().map(|p| 0.3 + 200.0 * p.x - 350.0 * p.y).collect();
+        let exact = 0.3 + 200.0 * x.x - 350.0 * x.y;
+        let a = av.average(&x, &pts, |_| h * h, &lin, |_| true);
+        assert!((a - exact).abs() < 1e-12, "{a} vs {exact}");
+    }
+
+    /// A band of damage (Gaussian profile of width 0.3 mm) averaged at two
+    /// spacings: the same average within 1 %.
+    #[test]
+    fn smooth_field_average_does_not_depend_on_the_spacing() {
+        let l = 1.0e-3;
+        let field = |p: &Vec2| 2.0 * (-(p.y / 0.3e-3).powi(2)).exp() + 0.1 * p.x / l;
+        let x = Vec2::new(0.11e-3, 0.17e-3);
+        let at = |h: Real| {
+            let pts = lattice(h, 3e-3);
+            let f: Vec<Real> = pts.iter().map(field).collect();
+            NonlocalAverage::new(&pts, l).average(&x, &pts, |_| h * h, &f, |_| true)
+        };
+        let (coarse, fine) = (at(0.12e-3), at(0.06e-3));
+        assert!((coarse / fine - 1.0).abs() < 0.01, "{coarse} vs {fine}");
+        // and not the point value: the band is narrower than ℓ
+        assert!(fine < 0.8 * field(&x), "{fine} vs {}", field(&x));
+    }
+
+    /// A band one lattice row wide (`w = h`) at damage 2 through the
+    /// centre averages to `2 h / L`, `L = 5πℓ/16`.
+    #[test]
+    fn thin_band_averages_over_its_closed_form_width() {
+        let (h, l) = (0.02e-3, 1.0e-3);
+        let pts = lattice(h, 1.5e-3);
+        // the lattice row at y = h/2, seen from a point on it
+        let f: Vec<Real> = pts.iter().map(|p| if (p.y - 0.5 * h).abs() < 0.5 * h { 2.0 } else { 0.0 }).collect();
+        let av = NonlocalAverage::new(&pts, l);
+        let x = Vec2::new(0.01e-3, 0.5 * h);
+        let a = av.average(&x, &pts, |_| h * h, &f, |_| true);
+        let exact = 2.0 * h / band_averaging_width(l);
+        assert!((a / exact - 1.0).abs() < 0.01, "{a} vs {exact}");
+        assert_eq!(band_critical_damage(0.2e-3, l), 0.2e-3 / band_averaging_width(l));
+        assert_eq!(band_critical_damage(2e-3, l), 1.0);
+    }
+
+    #[test]
+    fn excluded_points_do_not_count() {
+        let (h, l) = (0.1e-3, 0.5e-3);
+        let pts = lattice(h, 2e-3);
+        let av = NonlocalAverage::new(&pts, l);
+        // damage 3 below y = 0, 0 above; a "crack" along y = 0 hides the lower side
+        let f: Vec<Real> = pts.iter().map(|p| if p.y < 0.0 { 3.0 } else { 0.0 }).collect();
+        let x = Vec2::new(0.0, 0.05e-3);
+        let open = av.average(&x, &pts, |_| h * h, &f, |_| true);
+        let cut = av.average(&x, &pts, |_| h * h, &f, |q| pts[q].y > 0.0);
+        assert!(open > 1.0 && cut == 0.0, "{open} {cut}");
+    }
+}
