@@ -560,15 +560,16 @@ fn check_table(t: &ShapeTable, rows: usize, columns: usize, what: &str) -> Resul
     }
 }
 
-/// The contact: present exactly when the case has rigid bodies, its bodies
-/// the case's (outline, mass, prescribed motion) at their stored position
-/// and velocity, its parameters the case's, its lists whole.
+/// The contact: present exactly when the case has a contact stage
+/// ([`Case::has_contact`]), its bodies the case's (outline, mass,
+/// prescribed motion) at their stored position and velocity, its
+/// parameters the case's, its lists whole.
 fn check_contact(c: Option<&ContactSystem>, case: &Case, n: usize) -> Result<(), String> {
-    let c = match (c, case.rigid_bodies.is_empty()) {
-        (None, true) => return Ok(()),
-        (Some(_), true) => return Err("contact state without rigid bodies in the case".into()),
-        (None, false) => return Err("no contact state, but the case has rigid bodies".into()),
-        (Some(c), false) => c,
+    let c = match (c, case.has_contact()) {
+        (None, false) => return Ok(()),
+        (Some(_), false) => return Err("contact state, but the case has no contact".into()),
+        (None, true) => return Err("no contact state, but the case has contact".into()),
+        (Some(c), true) => c,
     };
     let expected = case.rigid_bodies().map_err(|e| e.to_string())?;
     if expected.len() != c.bodies.len() {

@@ -373,6 +373,8 @@ impl Simulation {
             for i in faces {
                 contact.slaves.add(i);
             }
+            let chains = cracks.cracks.iter().map(|c| c.face_chains()).collect();
+            contact.deformable.set_crack_faces(chains, &self.model.particle_shape, &self.model.particles.body);
         }
         internal_force(&mut self.model);
         Ok(())
@@ -411,7 +413,7 @@ impl Simulation {
             wp += s.work_on_particles;
             wb += s.work_on_body;
         }
-        self.energies.contact_work = wp;
+        self.energies.contact_work = wp + contact.deformable_work();
         self.energies.rigid_work = wb;
         self.energies.rigid_kinetic = rigid_kinetic_energy(contact);
         Ok(())

@@ -171,6 +171,28 @@ impl Crack {
             .collect()
     }
 
+    /// The particles of the two faces, `[left, right]`, each in the
+    /// direction of growth: the children of every split vertex, and a
+    /// growing tip closing both (the contact's master segments,
+    /// `crate::contact::deformable`).
+    pub fn face_chains(&self) -> [Vec<u32>; 2] {
+        let mut chains = [Vec::new(), Vec::new()];
+        for v in &self.vertices {
+            match (v.faces, self.tip) {
+                (Some((l, r)), _) => {
+                    chains[0].push(l);
+                    chains[1].push(r);
+                }
+                (None, Some(t)) if v.x0 == self.vertices.last().map_or(v.x0, |last| last.x0) => {
+                    chains[0].push(t as u32);
+                    chains[1].push(t as u32);
+                }
+                _ => {}
+            }
+        }
+        chains
+    }
+
     /// The two faces in the current configuration (`x = X + u(X)`, with
     /// the children's physical displacements): `[left, right]` polylines.
     /// A growing tip closes both; the end point past the surface moves with
