@@ -369,15 +369,24 @@ impl Simulation {
         if faces.is_empty() {
             return Ok(());
         }
-        if let Some(contact) = self.contact.as_mut() {
-            for i in faces {
-                contact.slaves.add(i);
-            }
-            let chains = cracks.cracks.iter().map(|c| c.face_chains()).collect();
-            contact.deformable.set_crack_faces(chains, &self.model.particle_shape, &self.model.particles.body);
-        }
+        self.crack_faces_changed(&faces);
         internal_force(&mut self.model);
         Ok(())
+    }
+
+    /// After cracks changed (grown here, or inserted with
+    /// [`CrackGrowth::insert_crack`]): the new face particles `faces` join
+    /// the contact slaves and the crack faces become master surfaces
+    /// (`contact::deformable`).
+    pub fn crack_faces_changed(&mut self, faces: &[usize]) {
+        let (Some(contact), Some(cracks)) = (self.contact.as_mut(), self.cracks.as_ref()) else {
+            return;
+        };
+        for &i in faces {
+            contact.slaves.add(i);
+        }
+        let chains = cracks.cracks.iter().map(|c| c.face_chains()).collect();
+        contact.deformable.set_crack_faces(chains, &self.model.particle_shape, &self.model.particles.body);
     }
 
     /// Contact forces of this step into `f_contact` (zero without contact).
