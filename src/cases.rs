@@ -26,7 +26,7 @@ pub const BUILTIN_CASES: &[(&str, &str, &str)] = &[
     (
         "two-plates-axisymmetric",
         include_str!("../cases/two-plates-axisymmetric.toml"),
-        "two spaced plates of different steels, rigid projectile at 350 m/s, axisymmetric (minutes)",
+        "two spaced plates of different steels, rigid projectile at 350 m/s, axisymmetric, to 60 us (a minute)",
     ),
     (
         "borvik-1-plane-strain",

@@ -386,7 +386,7 @@ impl OutputWriter {
             let (lo, hi) =
                 x0.iter().fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), p| (lo.min(p.x), hi.max(p.x)));
             let on_axis = sim.model.mode == crate::geometry::GeometryMode::Axisymmetric && lo <= 0.0;
-            (lo <= hi).then(|| if on_axis { 0.0 } else { 0.5 * (lo + hi) })
+            (lo <= hi).then_some(if on_axis { 0.0 } else { 0.5 * (lo + hi) })
         })
     }
 

@@ -58,7 +58,9 @@
 //!   Among the pairs left, the persistent one wins, then the face the slave
 //!   was farthest outside of at the start (the entry face), then the
 //!   shallower gap, then the lower segment index.
-//! - **Self-contact.** Within one body, only once it has cracks, and never
+//! - **Self-contact** (`contact.self_contact`, off by default:
+//!   [`super::ContactParameters::self_contact`] says why). Within one
+//!   body, only once it has cracks, and never
 //!   between a slave and a segment with an end in the slave's own
 //!   shape-function row: those particles are joined to it by material (the
 //!   rows leave out particles across a crack, so the two faces of a crack
@@ -601,7 +603,7 @@ impl DeformableMasters {
                 let (ga, gb) = (&s.points[vertex(a)], &s.points[vertex(b)]);
                 let d = gb.predicted - ga.predicted;
                 let l2 = d.norm_squared();
-                if !(l2 > 0.0) {
+                if l2.is_nan() || l2 <= 0.0 {
                     continue;
                 }
                 let along = (gs.predicted - ga.predicted).dot(&d) / l2;
