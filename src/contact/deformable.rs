@@ -548,7 +548,7 @@ impl DeformableMasters {
         gap_w: &mut Vec<(u32, Real)>,
         out: &mut Vec<Candidate>,
     ) -> Result<(), ContactError> {
-        if self.segments.is_empty() {
+        if self.segments.is_empty() || slaves.is_empty() {
             return Ok(());
         }
         let table = input.shape.ok_or(ContactError::MissingShapeTable { spreading: Spreading::ShapeFunction })?;
