@@ -37,7 +37,8 @@ pub struct Case {
     /// Rigid bodies (projectiles, anvils).
     #[serde(default)]
     pub rigid_bodies: Vec<RigidBodySpec>,
-    /// Contact with the rigid bodies (SPEC §8).
+    /// Contact with the rigid bodies (SPEC §8), between deformable bodies
+    /// and of a cracked body with itself (`crate::contact::deformable`).
     #[serde(default)]
     pub contact: crate::contact::ContactParameters,
     /// Heat conduction (SPEC §7).
@@ -926,6 +927,39 @@ impl Case {
     /// [`crate::residual`]), m/s.
     pub fn rigid_flights(&self) -> Vec<(String, Vec2)> {
         self.rigid_bodies.iter().map(|rb| (rb.name.clone(), Vec2::new(rb.velocity[0], rb.velocity[1]))).collect()
+    }
+
+    /// The deformable projectiles: each body given a non-zero initial
+    /// velocity over its whole body (an `initial_velocity` entry without a
+    /// region; the last such entry), with its index among the bodies and
+    /// that velocity (its flight direction, [`crate::residual`]), m/s.
+    pub fn deformable_flights(&self) -> Vec<(String, usize, Vec2)> {
+        self.bodies
+            .iter()
+            .enumerate()
+            .filter_map(|(b, body)| {
+                let v = body.initial_velocity.iter().rev().find(|iv| iv.region.is_none())?.velocity;
+                let v = Vec2::new(v[0], v[1]);
+                (v != Vec2::zeros()).then(|| (body.name.clone(), b, v))
+            })
+            .collect()
+    }
+
+    /// Every flight a run follows: the rigid bodies ([`Self::rigid_flights`]),
+    /// then the deformable projectiles ([`Self::deformable_flights`]).
+    pub fn flights(&self) -> Vec<(String, Vec2)> {
+        let mut f = self.rigid_flights();
+        f.extend(self.deformable_flights().into_iter().map(|(name, _, v)| (name, v)));
+        f
+    }
+
+    /// Whether the run has a contact stage: rigid bodies, two deformable
+    /// bodies or more with `contact.deformable`, or cracks with
+    /// `contact.self_contact`.
+    pub fn has_contact(&self) -> bool {
+        !self.rigid_bodies.is_empty()
+            || (self.contact.deformable && self.bodies.len() > 1)
+            || (self.contact.self_contact && self.fracture.criterion != crate::fracture::Criterion::None)
     }
 
     /// The time-step rule.

@@ -24,6 +24,11 @@ pub const BUILTIN_CASES: &[(&str, &str, &str)] = &[
         "elastic steel disc, struck centre, axisymmetric (seconds)",
     ),
     (
+        "two-plates-axisymmetric",
+        include_str!("../cases/two-plates-axisymmetric.toml"),
+        "two spaced plates of different steels, rigid projectile at 350 m/s, axisymmetric, to 60 us (a minute)",
+    ),
+    (
         "borvik-1-plane-strain",
         include_str!("../cases/borvik-1-plane-strain.toml"),
         "Borvik Case I (298 m/s, 11.1 mm), plane strain, coarse, effective-strain cracks",
@@ -47,6 +52,11 @@ pub const BUILTIN_CASES: &[(&str, &str, &str)] = &[
         "borvik-1-axisymmetric",
         include_str!("../cases/borvik-1-axisymmetric.toml"),
         "Borvik Case I (298 m/s, 11.1 mm), axisymmetric, coarse, effective-strain cracks",
+    ),
+    (
+        "borvik-1-axisymmetric-deformable",
+        include_str!("../cases/borvik-1-axisymmetric-deformable.toml"),
+        "Borvik Case I (298 m/s, 11.1 mm), axisymmetric, coarse, deformable tool-steel projectile",
     ),
     (
         "borvik-1-axisymmetric-damage",
@@ -147,6 +157,11 @@ pub const BUILTIN_CASES: &[(&str, &str, &str)] = &[
 /// [`borvik_family`] (checked by `tests/reference_cases.rs`). The conical
 /// nose is missing: its apex angle was not found.
 pub const BORVIK_NOSE_CASES: &[&str] = &["borvik-2002-12mm-blunt", "borvik-2002-12mm-hemispherical"];
+
+/// Børvik's Case I with the projectile as a deformable body of hardened
+/// Arne tool steel (issue #20), beside the rigid one; the numerical
+/// parameters of the coarse axisymmetric member of [`borvik_family`].
+pub const BORVIK_DEFORMABLE_CASES: &[&str] = &["borvik-1-axisymmetric-deformable"];
 
 /// Short names for the paper's models: `(alias, built-in case)`.
 pub const ALIASES: &[(&str, &str)] = &[("borvik-1", "borvik-1-plane-strain"), ("borvik-2", "borvik-2-plane-strain")];

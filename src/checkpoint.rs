@@ -55,8 +55,8 @@
 //! ([`CheckpointError::Version`]): versions 1 to 3 were hand-written
 //! sections of columns, versions 4 to 7 the postcard encoding (5 adds the
 //! run's fastest particle, 6 the crack-tip allowance, the crack stage's last
-//! time and the non-local fracture parameters, issue #19, 7 the adaptive
-//! stable step). The payload is
+//! time and the non-local fracture parameters, issue #19; 7 the adaptive
+//! stable step and the deformable contact, issues #19 and #20). The payload is
 //! [postcard](https://docs.rs/postcard) 1.x, whose wire format is stable
 //! within the major version: fields in declaration order, no names; an
 //! `f64` as its eight IEEE-754 bytes, so values (NaN payloads, −0.0)
@@ -126,7 +126,9 @@ pub const MAGIC: [u8; 8] = *b"PLUGCKPT";
 /// version 4 is the postcard encoding of the serde-derived state, version
 /// 5 adds the run's fastest particle (`Simulation::fastest`), version 6 the
 /// crack-tip allowance and the non-local fracture parameters, version 7
-/// the adaptive stable step (`Simulation::stable`, `dt_previous`).
+/// the adaptive stable step (`Simulation::stable`, `dt_previous`) and the
+/// deformable contact (its masters, persistent pairs and work, the
+/// `deformable` and `self_contact` switches; issue #20).
 pub const FORMAT_VERSION: u32 = 7;
 /// Subdirectory of a run's output directory that holds its checkpoints.
 pub const DIRECTORY: &str = "checkpoints";
@@ -562,15 +564,16 @@ fn check_table(t: &ShapeTable, rows: usize, columns: usize, what: &str) -> Resul
     }
 }
 
-/// The contact: present exactly when the case has rigid bodies, its bodies
-/// the case's (outline, mass, prescribed motion) at their stored position
-/// and velocity, its parameters the case's, its lists whole.
+/// The contact: present exactly when the case has a contact stage
+/// ([`Case::has_contact`]), its bodies the case's (outline, mass,
+/// prescribed motion) at their stored position and velocity, its
+/// parameters the case's, its lists whole.
 fn check_contact(c: Option<&ContactSystem>, case: &Case, n: usize) -> Result<(), String> {
-    let c = match (c, case.rigid_bodies.is_empty()) {
-        (None, true) => return Ok(()),
-        (Some(_), true) => return Err("contact state without rigid bodies in the case".into()),
-        (None, false) => return Err("no contact state, but the case has rigid bodies".into()),
-        (Some(c), false) => c,
+    let c = match (c, case.has_contact()) {
+        (None, false) => return Ok(()),
+        (Some(_), false) => return Err("contact state, but the case has no contact".into()),
+        (None, true) => return Err("no contact state, but the case has contact".into()),
+        (Some(c), true) => c,
     };
     let expected = case.rigid_bodies().map_err(|e| e.to_string())?;
     if expected.len() != c.bodies.len() {

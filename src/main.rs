@@ -789,6 +789,9 @@ fn drive(
             }
         }
     }
+    for (name, verdict) in s.flights.iter().filter(|(n, _)| !s.rigid_velocities.iter().any(|(r, _)| r == n)) {
+        println!("  deformable projectile {name} (mass-averaged velocity): {}", verdict.describe());
+    }
     for (id, nucleated, arrested) in &s.cracks {
         match arrested {
             Some(a) => println!("  crack {id}: nucleated at {:.3} us, arrested at {:.3} us", nucleated * 1e6, a * 1e6),

@@ -98,9 +98,12 @@ pub struct OutputWriter {
     crack_events_written: usize,
     /// The plug, followed from step to step.
     plug: crate::plug::PlugTracker,
-    /// Each rigid body's initial velocity (its flight), m/s.
+    /// Each flight's body: the rigid bodies, then the deformable
+    /// projectiles (`Case::flights`).
+    names: Vec<String>,
+    /// Each flight's initial velocity, m/s.
     flights: Vec<Vec2>,
-    /// Each rigid body's release, followed every step ([`crate::residual`]).
+    /// Each flight's release, followed every step ([`crate::residual`]).
     release: Vec<crate::residual::ReleaseTracker>,
     /// Step of the last history row (a step gets at most one).
     last_row_step: Option<u64>,
@@ -124,15 +127,17 @@ impl OutputWriter {
         let rigid_names: Vec<String> = rigid.iter().map(|r| r.0.clone()).collect();
         let cols = history_columns(&rigid_names);
         let cols: Vec<&str> = cols.iter().map(|s| s.as_str()).collect();
+        let history = HistoryWriter::create(&dir.join("history.csv"), &cols)?;
         Ok(OutputWriter {
             dir: dir.to_path_buf(),
             fields: fields.to_vec(),
             series: PvdSeries::create(&dir.join("results.pvd"))?,
-            history: HistoryWriter::create(&dir.join("history.csv"), &cols)?,
+            history,
             snapshots: 0,
             crack_log: None,
             crack_events_written: 0,
             plug: Default::default(),
+            names: rigid_names,
             flights: rigid.iter().map(|r| r.1).collect(),
             release: vec![Default::default(); rigid.len()],
             last_row_step: None,
@@ -199,6 +204,7 @@ impl OutputWriter {
             crack_log: None,
             crack_events_written: 0,
             plug: crate::plug::PlugTracker::continuing(first_cut),
+            names: rigid_names,
             flights: rigid.iter().map(|r| r.1).collect(),
             release: replay_releases(&kept, rigid),
             last_row_step,
@@ -304,7 +310,7 @@ impl OutputWriter {
             e.total(),
             e.drift(),
         ];
-        let plug = match (&sim.cracks, impact_line(sim)) {
+        let plug = match (&sim.cracks, self.impact_line(sim)) {
             (Some(cracks), Some(axis_x)) => self.plug.update(&sim.model, cracks, axis_x, sim.time),
             _ => None,
         };
@@ -318,9 +324,8 @@ impl OutputWriter {
             sim.contact.as_ref().map_or((0, 0), |c| c.exposed_counts(&sim.model.particles.flags));
         row.extend([admitted as Real, touching as Real]);
         row.push(crate::step::fastest_particle(&sim.model).0);
-        if let Some(c) = &sim.contact {
-            for b in 0..c.bodies.len() {
-                let s = c.sample(b).expect("body exists");
+        for b in 0..self.names.len() {
+            if let Some(s) = self.flight_sample(sim, b) {
                 row.extend([
                     s.position.x,
                     s.position.y,
@@ -357,7 +362,7 @@ impl OutputWriter {
             return Ok(());
         };
         self.write_crack_events(cracks)?;
-        if let Some(axis_x) = impact_line(sim) {
+        if let Some(axis_x) = self.impact_line(sim) {
             let before = self.plug.first_cut;
             self.plug.refresh(&sim.model, cracks, axis_x, sim.time);
             if before.is_none() && self.plug.first_cut.is_some() {
@@ -367,25 +372,61 @@ impl OutputWriter {
         Ok(())
     }
 
-    /// Whether every moving rigid body's flight is over, by the definitions
+    /// The impact line under which the plug is looked for: that of the
+    /// first rigid body ([`impact_line`]), else the x-centre of the first
+    /// deformable projectile's particles as generated (its side on the
+    /// axis, x = 0, in axisymmetry, where the rigid outlines are full
+    /// sections centred on the axis).
+    pub fn impact_line(&self, sim: &Simulation) -> Option<Real> {
+        impact_line(sim).or_else(|| {
+            let rigid = sim.contact.as_ref().map_or(0, |c| c.bodies.len());
+            let name = self.names.get(rigid)?;
+            let body = sim.model.bodies.iter().find(|b| &b.name == name)?;
+            let x0 = sim.model.particles.x0.get(body.particles.clone())?;
+            let (lo, hi) =
+                x0.iter().fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), p| (lo.min(p.x), hi.max(p.x)));
+            let on_axis = sim.model.mode == crate::geometry::GeometryMode::Axisymmetric && lo <= 0.0;
+            (lo <= hi).then_some(if on_axis { 0.0 } else { 0.5 * (lo + hi) })
+        })
+    }
+
+    /// Flight `b`'s sample now: rigid body `b` of the contact, or after
+    /// them the deformable projectile of that name, its mass-averaged
+    /// motion and the contact force on it
+    /// ([`crate::contact::ContactSystem::deformable_sample`]).
+    fn flight_sample(&self, sim: &Simulation, b: usize) -> Option<crate::contact::BodySample> {
+        let rigid = sim.contact.as_ref().map_or(0, |c| c.bodies.len());
+        if b < rigid {
+            return sim.contact.as_ref()?.sample(b);
+        }
+        let name = self.names.get(b)?;
+        let body = sim.model.bodies.iter().position(|i| &i.name == name)? as u32;
+        let p = &sim.model.particles;
+        Some(crate::contact::deformable_sample(p, &sim.f_contact, body, sim.contact.as_ref()))
+    }
+
+    /// Whether every moving body's flight is over, by the definitions
     /// of [`crate::residual`] held for `wait` (s): stopped or moving back, or
     /// free of force along its flight with a plug cut out (both for `wait`:
     /// the plug, thrown ahead, may still be caught again). Call
     /// after every step (`time.stop_after_release`); false without a
-    /// moving rigid body (one with an initial velocity, not prescribed).
+    /// moving body (a rigid one with an initial velocity, not prescribed, or
+    /// a deformable projectile).
     pub fn flights_over(&mut self, sim: &Simulation, wait: Real) -> bool {
-        let Some(contact) = &sim.contact else {
-            return false;
-        };
         let cut = self.plug.first_cut;
         let mut moving = 0;
         let mut over = 0;
-        for b in 0..contact.bodies.len().min(self.release.len()) {
+        for b in 0..self.names.len().min(self.release.len()) {
             let impact = self.flights[b].norm();
-            if impact == 0.0 || contact.bodies[b].prescribed_velocity.is_some() {
+            let prescribed =
+                sim.contact.as_ref().and_then(|c| c.bodies.get(b)).is_some_and(|r| r.prescribed_velocity.is_some());
+            if impact == 0.0 || prescribed {
                 continue;
             }
-            let (s, dir) = (contact.sample(b).expect("body exists"), self.flight_direction(b));
+            let Some(s) = self.flight_sample(sim, b) else {
+                continue;
+            };
+            let dir = self.flight_direction(b);
             let tracker = &mut self.release[b];
             tracker.observe(sim.time, s.contact_force.dot(&dir), s.velocity.dot(&dir), impact);
             let stopped = tracker.stopped_for(sim.time).is_some_and(|t| t >= wait);

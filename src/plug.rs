@@ -79,13 +79,19 @@ impl Plug {
 /// the nearest particle's distance), the one nearest the middle of that
 /// column's extent. `None` for an empty model.
 pub fn seed_particle(model: &Model, axis_x: Real) -> Option<usize> {
+    seed_particle_in(model, axis_x, |_| true)
+}
+
+/// [`seed_particle`] among the particles of the bodies `accept` takes.
+pub fn seed_particle_in(model: &Model, axis_x: Real, accept: impl Fn(u32) -> bool) -> Option<usize> {
     let p = &model.particles;
-    let nearest = (0..p.len()).map(|i| (p.x0[i].x - axis_x).abs()).fold(Real::INFINITY, Real::min);
+    let members = || (0..p.len()).filter(|&i| accept(p.body[i]));
+    let nearest = members().map(|i| (p.x0[i].x - axis_x).abs()).fold(Real::INFINITY, Real::min);
     if !nearest.is_finite() {
         return None;
     }
     let column: Vec<usize> =
-        (0..p.len()).filter(|&i| (p.x0[i].x - axis_x).abs() <= nearest + 0.5 * p.spacing[i]).collect();
+        members().filter(|&i| (p.x0[i].x - axis_x).abs() <= nearest + 0.5 * p.spacing[i]).collect();
     let (lo, hi) =
         column.iter().fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), &i| (lo.min(p.x0[i].y), hi.max(p.x0[i].y)));
     let middle = Vec2::new(axis_x, 0.5 * (lo + hi));
@@ -104,11 +110,27 @@ fn supported(flags: ParticleFlags) -> bool {
 /// The particles of the piece cut out around the seed particle under the
 /// impact line `x = axis_x` (module doc), or `None` if the cracks do not
 /// sever it from the supports (or there are no arrested cracks at all).
+/// The seed is taken in the cracked bodies only (with several bodies, a
+/// deformable projectile or a second plate lies on the same line; the
+/// first cracked body, in body order, whose piece is cut out is the plug).
 pub fn plug_particles(model: &Model, cracks: &CrackGrowth, axis_x: Real) -> Option<Vec<usize>> {
     if !cracks.cracks.iter().any(|c| c.arrested.is_some()) {
         return None;
     }
-    let seed = seed_particle(model, axis_x)?;
+    let p = &model.particles;
+    let mut cracked: Vec<u32> =
+        (0..p.len()).filter(|&i| p.flags[i].has(ParticleFlags::CRACK_FACE)).map(|i| p.body[i]).collect();
+    cracked.sort_unstable();
+    cracked.dedup();
+    if cracked.len() <= 1 {
+        let any = cracked.is_empty();
+        return plug_in(model, cracks, seed_particle_in(model, axis_x, |b| any || cracked.contains(&b))?);
+    }
+    cracked.iter().find_map(|&b| plug_in(model, cracks, seed_particle_in(model, axis_x, |c| c == b)?))
+}
+
+/// The piece cut out around particle `seed` (module doc), if it is one.
+fn plug_in(model: &Model, cracks: &CrackGrowth, seed: usize) -> Option<Vec<usize>> {
     let p = &model.particles;
     let body = p.body[seed];
     let body_count = p.body.iter().filter(|&&b| b == body).count();

@@ -3,7 +3,7 @@
 
 use crate::case::Case;
 use crate::checkpoint::{CheckpointError, RunProgress};
-use crate::contact::{ContactSystem, SlaveSet, SurfaceDetection};
+use crate::contact::{ContactSystem, DeformableMasters, DeformableSwitches, SlaveSet, SurfaceDetection};
 use crate::io::IoError;
 use crate::math::Real;
 use crate::memory::{Footprint, MemoryError};
@@ -213,14 +213,18 @@ fn build_simulation_without_cracks(case: &Case) -> Result<Simulation, RunError> 
     preflight(case)?;
     let model = Model::build(case.geometry.mode, &case.body_setups())?;
     let rule = case.time_step_rule();
-    let sim = if case.rigid_bodies.is_empty() {
+    let sim = if !case.has_contact() {
         Simulation::new(model, rule)
     } else {
         let bodies = case.rigid_bodies()?;
-        let slaves = SlaveSet::detect(&model.particles.x0, &model.particles.spacing, &SurfaceDetection::default())?;
+        let p = &model.particles;
+        let slaves = SlaveSet::detect_per_body(&p.x0, &p.spacing, &p.body, &SurfaceDetection::default())?;
         let mut model = model;
         slaves.mark_flags(&mut model.particles.flags)?;
-        let contact = ContactSystem::new(bodies, slaves, case.contact)?;
+        let switches = DeformableSwitches { bodies: case.contact.deformable, self_contact: case.contact.self_contact };
+        let ranges: Vec<_> = model.bodies.iter().map(|b| b.particles.clone()).collect();
+        let masters = DeformableMasters::of_bodies(&model.particles, &ranges, switches);
+        let contact = ContactSystem::new(bodies, slaves, case.contact)?.with_deformable(masters);
         Simulation::with_contact(model, rule, contact)
     };
     check_time_step(&sim, case.time.end)?;
@@ -277,7 +281,7 @@ pub fn execute(case: &Case, cfg: &RunConfig, progress: &mut dyn FnMut(Progress))
     };
     write("case.resolved.toml", case.resolved_toml())?;
     write("run_info.toml", toml::to_string_pretty(&cfg.info).unwrap_or_default())?;
-    let out = OutputWriter::create(&cfg.out_dir, &case.output.fields, &case.rigid_flights())?;
+    let out = OutputWriter::create(&cfg.out_dir, &case.output.fields, &case.flights())?;
     let schedule = Schedule {
         next_snapshot: 0.0,
         next_checkpoint: case.checkpoint.interval.unwrap_or(Real::INFINITY),
@@ -305,7 +309,7 @@ pub fn resume(cfg: &RunConfig, progress: &mut dyn FnMut(Progress)) -> Result<Run
     let out = OutputWriter::resume(
         &cfg.out_dir,
         &case.output.fields,
-        &case.rigid_flights(),
+        &case.flights(),
         &saved.snapshot_times,
         saved.history_bytes,
         sim.cracks.as_ref(),
@@ -499,7 +503,7 @@ fn time_loop(
     let last_contacts = crate::output::last_contact_times(&history, &names);
     let perforation = crate::output::perforation_time(&history);
     let flights = case
-        .rigid_flights()
+        .flights()
         .into_iter()
         .filter_map(|(name, v0)| {
             let dir = crate::residual::flight_direction(v0);
@@ -508,7 +512,7 @@ fn time_loop(
             Some((name, verdict))
         })
         .collect();
-    let plug = match (&sim.cracks, crate::output::impact_line(&sim)) {
+    let plug = match (&sim.cracks, out.impact_line(&sim)) {
         (Some(c), Some(axis_x)) => crate::plug::find_plug(&sim.model, c, axis_x),
         _ => None,
     };

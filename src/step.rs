@@ -383,11 +383,7 @@ impl Simulation {
         if faces.is_empty() {
             return Ok(false);
         }
-        if let Some(contact) = self.contact.as_mut() {
-            for i in faces {
-                contact.slaves.add(i);
-            }
-        }
+        self.crack_faces_changed(&faces);
         internal_force(&mut self.model);
         Ok(true)
     }
@@ -413,6 +409,21 @@ impl Simulation {
             self.cracks.as_ref().is_some_and(|c| c.params.critical_value().is_some() && c.params.fractures_points());
         let dt = stable.evaluate(&self.model, self.time, fracturing);
         self.dt = dt;
+    }
+
+    /// After cracks changed (grown here, or inserted with
+    /// [`CrackGrowth::insert_crack`]): the new face particles `faces` join
+    /// the contact slaves and the crack faces become master surfaces
+    /// (`contact::deformable`).
+    pub fn crack_faces_changed(&mut self, faces: &[usize]) {
+        let (Some(contact), Some(cracks)) = (self.contact.as_mut(), self.cracks.as_ref()) else {
+            return;
+        };
+        for &i in faces {
+            contact.slaves.add(i);
+        }
+        let chains = cracks.cracks.iter().map(|c| c.face_chains()).collect();
+        contact.deformable.set_crack_faces(chains, &self.model.particle_shape, &self.model.particles.body);
     }
 
     /// Contact forces of this step into `f_contact` (zero without contact).
@@ -449,7 +460,7 @@ impl Simulation {
             wp += s.work_on_particles;
             wb += s.work_on_body;
         }
-        self.energies.contact_work = wp;
+        self.energies.contact_work = wp + contact.deformable_work();
         self.energies.rigid_work = wb;
         self.energies.rigid_kinetic = rigid_kinetic_energy(contact);
         Ok(())

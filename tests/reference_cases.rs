@@ -6,7 +6,7 @@
 //! the projectile.
 
 use plugsim::case::Case;
-use plugsim::cases::{borvik_family, builtin_case, ALIASES, BORVIK_NOSE_CASES, BUILTIN_CASES};
+use plugsim::cases::{borvik_family, builtin_case, ALIASES, BORVIK_DEFORMABLE_CASES, BORVIK_NOSE_CASES, BUILTIN_CASES};
 use plugsim::fracture::{Criterion, EventKind};
 use plugsim::geometry::GeometryMode;
 use plugsim::material::Constitutive;
@@ -77,7 +77,10 @@ fn every_case_file_is_a_built_in_and_every_borvik_built_in_is_in_the_family() {
     let family: Vec<String> = borvik_family().iter().map(|m| m.name()).collect();
     for (name, _, _) in BUILTIN_CASES.iter().filter(|c| c.0.starts_with("borvik-")) {
         assert!(
-            family.iter().any(|f| f == name) || *name == "borvik-1-nofracture" || BORVIK_NOSE_CASES.contains(name),
+            family.iter().any(|f| f == name)
+                || *name == "borvik-1-nofracture"
+                || BORVIK_NOSE_CASES.contains(name)
+                || BORVIK_DEFORMABLE_CASES.contains(name),
             "{name} outside the family"
         );
     }

@@ -1,5 +1,6 @@
-//! Contact of the deformable target with rigid bodies (SPEC §8,
-//! [RL10, §3, Eqs. (3.1)–(3.10)]).
+//! Contact of the deformable bodies with rigid bodies (SPEC §8,
+//! [RL10, §3, Eqs. (3.1)–(3.10)]), with each other and of a cracked body
+//! with itself ([`deformable`], issue #20).
 //!
 //! - [`rigid`]: rigid bodies with polygonal outlines (the masters), their
 //!   mass from a section (plane strain) or a volume of revolution
@@ -11,6 +12,10 @@
 //! - [`grid`]: the uniform cell grid of the coarse search;
 //!   [`search`]: nearest vertex → segment (or vertex) → signed gap.
 //! - [`force`]: one-step normal force, Coulomb friction, spreading weights.
+//! - [`deformable`]: deformable masters (the bodies' boundaries and crack
+//!   faces as particle polylines, at their physical points), their search,
+//!   and the signed gap rows that put both sides of a pair into one force
+//!   row; solved with the rigid pairs in one Gauss–Seidel solve.
 //! - [`system`]: [`ContactSystem`], the stage the time loop calls.
 //!
 //! # Use in the time loop
@@ -59,6 +64,7 @@
 //! - Slaves by exposure: interior particles that come within a spacing of
 //!   a rigid body join the slaves ([`ContactSystem::admit_exposed`]).
 
+pub mod deformable;
 pub mod force;
 pub mod grid;
 pub mod projectile;
@@ -68,13 +74,17 @@ pub mod slave;
 pub mod surface;
 pub mod system;
 
+pub use deformable::{rectangle_boundary, DeformableMasters, DeformableSwitches, Segment, SegmentContact};
 pub use force::Spreading;
 pub use projectile::{NoseShape, Projectile};
 pub use rigid::{mass_axisymmetric, mass_plane_strain, polygons_overlap, rectangle_outline, RigidBody};
 pub use search::{search_rigid_polygon, search_rigid_polygon_brute_force, Projection};
 pub use slave::{MasterFeature, Pairing, SlaveSet};
 pub use surface::{detect_surface, SurfaceDetection};
-pub use system::{ActiveContact, BodySample, ContactParameters, ContactSystem, StepInput, StepReport, EXPOSED_REACH};
+pub use system::{
+    deformable_sample, ActiveContact, BodySample, ContactParameters, ContactSystem, StepInput, StepReport,
+    EXPOSED_REACH,
+};
 
 use crate::math::Real;
 

@@ -71,6 +71,44 @@ impl SlaveSet {
         Ok(Self::from_indices(detect_surface(positions, spacing, params)?))
     }
 
+    /// The surface particles of each body of a particle set, found
+    /// geometrically body by body ([`detect_surface`] on the particles of
+    /// `body[i] == b`): bodies that touch do not hide each other's surface.
+    /// The same set as [`Self::detect`] for one body.
+    pub fn detect_per_body(
+        positions: &[Vec2],
+        spacing: &[Real],
+        body: &[u32],
+        params: &SurfaceDetection,
+    ) -> Result<Self, ContactError> {
+        if body.len() != positions.len() {
+            return Err(ContactError::LengthMismatch { field: "body", expected: positions.len(), found: body.len() });
+        }
+        if spacing.len() != positions.len() {
+            return Err(ContactError::LengthMismatch {
+                field: "spacing",
+                expected: positions.len(),
+                found: spacing.len(),
+            });
+        }
+        let mut bodies: Vec<u32> = body.to_vec();
+        bodies.sort_unstable();
+        bodies.dedup();
+        if bodies.len() <= 1 {
+            return Self::detect(positions, spacing, params);
+        }
+        let mut set = Self::new();
+        for b in bodies {
+            let members: Vec<usize> = (0..positions.len()).filter(|&i| body[i] == b).collect();
+            let x: Vec<Vec2> = members.iter().map(|&i| positions[i]).collect();
+            let h: Vec<Real> = members.iter().map(|&i| spacing[i]).collect();
+            for k in detect_surface(&x, &h, params)? {
+                set.add(members[k]);
+            }
+        }
+        Ok(set)
+    }
+
     /// Add particle `i` (e.g. a new crack-face particle). Returns `false`
     /// if it was already a slave.
     pub fn add(&mut self, i: usize) -> bool {

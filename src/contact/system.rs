@@ -15,6 +15,7 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::deformable::{DeformableMasters, SegmentContact};
 use super::force::{coulomb_cap, inverse_distance_weights, one_step_normal_force, stick_force, Spreading};
 use super::rigid::RigidBody;
 use super::search::{check_pairing, search_rigid_polygon, Projection};
@@ -56,6 +57,20 @@ pub struct ContactParameters {
     /// that comes within one spacing of a rigid body (or inside it) joins
     /// the slave set even if it started in the interior. Default on.
     pub admit_exposed: bool,
+    /// Contact between different deformable bodies
+    /// ([`super::deformable`]). Default on: bodies do not pass through
+    /// each other.
+    pub deformable: bool,
+    /// Contact of a cracked body with itself: the faces of its cracks, and
+    /// a plug cut out against the rest ([`super::deformable`]). Default
+    /// off: it passes its tests (faces pressed together do not cross), but
+    /// on the coarse Børvik rows it made three of the first four measured
+    /// go unstable (plane-strain Case I at 52.7 µs, with the damage
+    /// criterion at 16.9 µs, axisymmetric Case I with damage at 33.2 µs),
+    /// where crack faces sheared against each other carry one-step forces
+    /// in crushed material; axisymmetric Case I ran (242.27 m/s against
+    /// 245.50 m/s without). Off, every single-body case keeps its bits.
+    pub self_contact: bool,
 }
 
 /// Reach of [`ContactSystem::admit_exposed`], in the particle's spacing `h`.
@@ -70,6 +85,8 @@ impl Default for ContactParameters {
             max_iterations: 50,
             tolerance: 1e-8,
             admit_exposed: true,
+            deformable: true,
+            self_contact: false,
         }
     }
 }
@@ -117,6 +134,8 @@ pub struct StepInput<'a> {
     pub support: &'a [Real],
     /// Flags: `FIX_X` / `FIX_Y` components are held (supports, the axis).
     pub flags: &'a [ParticleFlags],
+    /// Body of each particle (deformable masters).
+    pub body: &'a [u32],
     /// Shape functions at the particles, `N_J(X_I)` in row `I`; needed by
     /// [`Spreading::InverseDistance`] and [`Spreading::ShapeFunction`].
     pub shape: Option<&'a ShapeTable>,
@@ -141,6 +160,7 @@ impl<'a> StepInput<'a> {
             spacing: &p.spacing,
             support: &p.support,
             flags: &p.flags,
+            body: &p.body,
             shape,
             dt,
             dt_velocity: dt,
@@ -163,6 +183,7 @@ impl<'a> StepInput<'a> {
             ("spacing", self.spacing.len()),
             ("support", self.support.len()),
             ("flags", self.flags.len()),
+            ("body", self.body.len()),
         ];
         for (field, found) in lens {
             if found != n {
@@ -287,6 +308,18 @@ pub struct ContactSystem {
     /// `Δt`, `Δt_v` and particle count of a `compute_forces` not yet followed by
     /// `advance`.
     pending: Option<(Real, Real, usize)>,
+    /// Deformable master surfaces: other bodies' boundaries and crack faces
+    /// ([`super::deformable`]).
+    pub deformable: DeformableMasters,
+    /// Deformable contacts of the last `compute_forces`.
+    segment_contacts: Vec<SegmentContact>,
+    /// Forces of the deformable contacts applied in the last
+    /// `compute_forces`: (particle, f_J, the particle's `V^{n−½}`).
+    applied_deformable: Vec<(u32, Vec2, Vec2)>,
+    /// Cumulative work of the deformable contacts' forces on the particles,
+    /// `Σ f_J·ΔU_J`, J (both sides of every pair; its negative is the
+    /// energy those contacts dissipated).
+    deformable_work: Real,
     /// Scratch: (particle, weight) rows of the gap points and, for
     /// inverse-distance spreading, of the forces; the pairs being solved.
     /// Not in checkpoints (this and `gap_points`): cleared, or resized and
@@ -303,14 +336,14 @@ pub struct ContactSystem {
 }
 
 /// A slave's gap point over the step: the shape-weighted sums of its row.
-#[derive(Clone, Copy, Debug)]
-struct GapPoint {
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(super) struct GapPoint {
     /// Contact-free predicted position `X + Ũ^{n+1}`, m.
-    predicted: Vec2,
+    pub predicted: Vec2,
     /// Position at the start of the step `X + U^n`, m.
-    now: Vec2,
+    pub now: Vec2,
     /// Contact-free predicted velocity `Ṽ`, m/s.
-    velocity: Vec2,
+    pub velocity: Vec2,
 }
 
 impl ContactSystem {
@@ -330,11 +363,21 @@ impl ContactSystem {
             work_on_particles: vec![0.0; nb],
             work_on_body: vec![0.0; nb],
             pending: None,
+            deformable: DeformableMasters::default(),
+            segment_contacts: Vec::new(),
+            applied_deformable: Vec::new(),
+            deformable_work: 0.0,
             gap_w: Vec::new(),
             force_w: Vec::new(),
             candidates: Vec::new(),
             gap_points: Vec::new(),
         })
+    }
+
+    /// The same system with deformable masters ([`super::deformable`]).
+    pub fn with_deformable(mut self, masters: DeformableMasters) -> Self {
+        self.deformable = masters;
+        self
     }
 
     /// Slaves by exposure (SPEC §8 deviation; on with
@@ -398,9 +441,31 @@ impl ContactSystem {
     }
 
     /// Total cumulative contact work over all bodies, J (see
-    /// [`BodySample::work_on_particles`] and [`BodySample::work_on_body`]).
+    /// [`BodySample::work_on_particles`] and [`BodySample::work_on_body`]),
+    /// with that of the deformable contacts ([`Self::deformable_work`]).
     pub fn contact_work(&self) -> Real {
-        self.work_on_particles.iter().chain(&self.work_on_body).sum()
+        self.work_on_particles.iter().chain(&self.work_on_body).sum::<Real>() + self.deformable_work
+    }
+
+    /// Cumulative work of the deformable contacts' forces on the particles
+    /// (both sides of every pair), J; its negative is the energy they
+    /// dissipated (≥ 0 for a well-behaved contact).
+    pub fn deformable_work(&self) -> Real {
+        self.deformable_work
+    }
+
+    /// Deformable contacts of the last [`Self::compute_forces`].
+    pub fn segment_contacts(&self) -> &[SegmentContact] {
+        &self.segment_contacts
+    }
+
+    /// Number of the last step's contacts that touched deformable body
+    /// `body`: rigid pairs whose slave is its particle, deformable pairs with
+    /// its particle as the slave or a master end.
+    pub fn contacts_touching(&self, body_of: &[u32], body: u32) -> usize {
+        let of = |i: u32| body_of.get(i as usize) == Some(&body);
+        let rigid = self.contacts.iter().filter(|c| of(c.particle)).count();
+        rigid + self.segment_contacts.iter().filter(|c| of(c.particle) || of(c.segment[0]) || of(c.segment[1])).count()
     }
 
     /// Total linear momentum of the rigid bodies, kg m/s.
@@ -440,7 +505,8 @@ impl ContactSystem {
             }
         }
         let vertices: Vec<usize> = self.bodies.iter().map(RigidBody::vertex_count).collect();
-        self.slaves.check(n, &vertices)
+        self.slaves.check(n, &vertices)?;
+        self.deformable.check(n)
     }
 
     fn resize_per_body(&mut self) {
@@ -504,6 +570,8 @@ impl ContactSystem {
         f_contact.fill(Vec2::zeros());
         self.contacts.clear();
         self.applied.clear();
+        self.segment_contacts.clear();
+        self.applied_deformable.clear();
         self.candidates.clear();
         self.gap_w.clear();
         self.force_w.clear();
@@ -581,36 +649,21 @@ impl ContactSystem {
                     Spreading::InverseDistance => &self.force_w[rows(force_rows)],
                     Spreading::None | Spreading::ShapeFunction => &self.gap_w[rows(gap_rows)],
                 };
-                // Compliance of the gap point to its own force, per direction:
-                // Σ_J (gap weight)(force weight) (d·P_J d)/m_J.
-                let (mut c_n, mut c_t) = (0.0, 0.0);
-                for &(j, wg) in &self.gap_w[rows(gap_rows)] {
-                    for &(jf, wf) in force_w {
-                        if jf == j {
-                            let r = mobility(input, j as usize);
-                            c_n += wg * wf * (normal.x * normal.x * r.x + normal.y * normal.y * r.y);
-                            c_t += wg * wf * (tangent.x * tangent.x * r.x + tangent.y * tangent.y * r.y);
-                        }
-                    }
-                }
-                self.candidates.push(Candidate {
-                    particle: s as u32,
-                    pairing,
-                    gap_rows,
-                    force_rows,
-                    gap,
-                    normal,
-                    tangent,
-                    slip_velocity: (vel - body.predicted_velocity()).dot(&tangent),
-                    mass_normal: effective_mass(c_n),
-                    mass_tangent: effective_mass(c_t),
-                    f_n: 0.0,
-                    f_t: 0.0,
-                    slipping: false,
-                });
+                let (c_n, c_t) = row_compliance(input, &self.gap_w[rows(gap_rows)], force_w, &normal, &tangent);
+                self.candidates.push(
+                    Candidate::new(s as u32, Master::Rigid(pairing), gap_rows, force_rows, gap, normal).with_motion(
+                        (vel - body.predicted_velocity()).dot(&tangent),
+                        c_n,
+                        c_t,
+                    ),
+                );
             }
             self.slaves.set_pairing(k, found);
         }
+        // Deformable masters (after the rigid pairs, so that a run without
+        // deformable pairs solves exactly what it did before).
+        let physical = (spreading == Spreading::ShapeFunction).then_some(&self.gap_points[..]);
+        self.deformable.candidates(input, self.slaves.particles(), physical, &mut self.gap_w, &mut self.candidates)?;
 
         // 2. Projected Gauss–Seidel on the penetrating pairs; f_contact holds
         // the forces of the current iterate.
@@ -660,21 +713,45 @@ impl ContactSystem {
                 continue; // released by its neighbours
             }
             let force = c.normal * c.f_n + c.tangent * c.f_t;
+            let pairing = match c.master {
+                Master::Rigid(pairing) => pairing,
+                Master::Segment { segment, lambda } => {
+                    // Both sides are in the one row: nothing to react.
+                    for &(j, w) in &self.gap_w[c.force_rows.0 as usize..c.force_rows.1 as usize] {
+                        let f = force * w;
+                        f_contact[j as usize] += f;
+                        total += f;
+                        self.applied_deformable.push((j, f, input.v[j as usize]));
+                    }
+                    self.segment_contacts.push(SegmentContact {
+                        particle: c.particle,
+                        segment,
+                        lambda,
+                        gap: c.gap,
+                        normal: c.normal,
+                        normal_force: c.f_n,
+                        tangential_force: c.f_t,
+                        slipping: c.slipping,
+                        force,
+                    });
+                    continue;
+                }
+            };
             let rows = if id { &self.force_w[..] } else { &self.gap_w[..] };
             let mut applied = Vec2::zeros();
             for &(j, w) in &rows[c.force_rows.0 as usize..c.force_rows.1 as usize] {
                 let f = force * w;
                 f_contact[j as usize] += f;
                 applied += f;
-                self.applied.push((j, c.pairing.body, f, input.v[j as usize]));
+                self.applied.push((j, pairing.body, f, input.v[j as usize]));
             }
-            let b = c.pairing.body as usize;
+            let b = pairing.body as usize;
             self.reaction[b] -= applied;
             self.active_per_body[b] += 1;
             total += applied;
             self.contacts.push(ActiveContact {
                 particle: c.particle,
-                pairing: c.pairing,
+                pairing,
                 gap: c.gap,
                 normal: c.normal,
                 effective_mass: c.mass_normal,
@@ -684,6 +761,7 @@ impl ContactSystem {
                 force: applied,
             });
         }
+        self.deformable.remember(self.segment_contacts.iter().map(|c| (c.particle, c.segment)));
         self.pending = Some((dt, dt_v, n));
         Ok(StepReport { active_contacts: self.contacts.len(), force_on_particles: total, iterations })
     }
@@ -715,6 +793,9 @@ impl ContactSystem {
             let v_new = v[j as usize];
             self.work_on_particles[b as usize] += 0.5 * dt_v * f.dot(&(v_old + v_new));
         }
+        for &(j, f, v_old) in &self.applied_deformable {
+            self.deformable_work += 0.5 * dt_v * f.dot(&(v_old + v[j as usize]));
+        }
         for (b, body) in self.bodies.iter_mut().enumerate() {
             let v_old = body.velocity;
             body.advance(self.reaction[b], dt_v, dt);
@@ -724,11 +805,21 @@ impl ContactSystem {
     }
 }
 
-/// A penetrating slave–body pair during the force solve.
+/// What a slave is pressed against.
 #[derive(Clone, Copy, Debug)]
-struct Candidate {
+pub(super) enum Master {
+    /// A rigid body's feature: the reaction acts on the body.
+    Rigid(Pairing),
+    /// A deformable master segment at parameter `lambda`: the gap row holds
+    /// both sides, and so does the force ([`super::deformable`]).
+    Segment { segment: [u32; 2], lambda: Real },
+}
+
+/// A penetrating slave–master pair during the force solve.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Candidate {
     particle: u32,
-    pairing: Pairing,
+    master: Master,
     /// Range of the gap point's (particle, weight) entries in `gap_w`.
     gap_rows: (u32, u32),
     /// Range of the force's entries in `force_w` (inverse distance) or `gap_w`.
@@ -746,6 +837,67 @@ struct Candidate {
     f_n: Real,
     f_t: Real,
     slipping: bool,
+}
+
+impl Candidate {
+    /// A pair with no force yet: slave `particle`, its `master`, the ranges
+    /// of its gap and force rows, its predicted gap and the master's normal.
+    pub(super) fn new(
+        particle: u32,
+        master: Master,
+        gap_rows: (u32, u32),
+        force_rows: (u32, u32),
+        gap: Real,
+        normal: Vec2,
+    ) -> Self {
+        Candidate {
+            particle,
+            master,
+            gap_rows,
+            force_rows,
+            gap,
+            normal,
+            tangent: Vec2::new(-normal.y, normal.x),
+            slip_velocity: 0.0,
+            mass_normal: Real::INFINITY,
+            mass_tangent: Real::INFINITY,
+            f_n: 0.0,
+            f_t: 0.0,
+            slipping: false,
+        }
+    }
+
+    /// With the predicted relative tangential velocity (m/s) and the gap
+    /// point's compliances along the normal and the tangent (1/kg).
+    pub(super) fn with_motion(mut self, slip_velocity: Real, c_n: Real, c_t: Real) -> Self {
+        self.slip_velocity = slip_velocity;
+        self.mass_normal = effective_mass(c_n);
+        self.mass_tangent = effective_mass(c_t);
+        self
+    }
+}
+
+/// Compliance of a gap point to its own force, per direction (1/kg):
+/// `Σ_J (gap weight)(force weight) (d·P_J d)/m_J` over the entries of the
+/// two rows that name the same particle, for `d` the normal and the tangent.
+pub(super) fn row_compliance(
+    input: &StepInput,
+    gap: &[(u32, Real)],
+    force: &[(u32, Real)],
+    normal: &Vec2,
+    tangent: &Vec2,
+) -> (Real, Real) {
+    let (mut c_n, mut c_t) = (0.0, 0.0);
+    for &(j, wg) in gap {
+        for &(jf, wf) in force {
+            if jf == j {
+                let r = mobility(input, j as usize);
+                c_n += wg * wf * (normal.x * normal.x * r.x + normal.y * normal.y * r.y);
+                c_t += wg * wf * (tangent.x * tangent.x * r.x + tangent.y * tangent.y * r.y);
+            }
+        }
+    }
+    (c_n, c_t)
 }
 
 /// Displacement response `P_J / m_J` of particle `j` per unit force (per
@@ -802,7 +954,7 @@ fn checked_shape_row<'a>(input: &StepInput<'a>, s: usize) -> Result<&'a ShapeTab
 /// predicted position and velocity and the current position, weighted by
 /// its shape-function row in row order (by the particle alone without
 /// shape-function spreading).
-fn predict_gap_point(input: &StepInput, s: usize, spreading: Spreading) -> Result<GapPoint, ContactError> {
+pub(super) fn predict_gap_point(input: &StepInput, s: usize, spreading: Spreading) -> Result<GapPoint, ContactError> {
     let mut g = GapPoint { predicted: input.x0[s], now: input.x0[s], velocity: Vec2::zeros() };
     let mut add = |j: usize, w: Real| -> Result<(), ContactError> {
         let (u_pred, v_pred) = input.predicted(j)?;
@@ -858,4 +1010,38 @@ fn inverse_distance_neighbours(
         }
     }
     Ok(())
+}
+
+/// Time-history sample of deformable body `body` as a projectile: the
+/// centre of mass of its generalized positions `X + U` and its mass-averaged
+/// velocity (its momentum over its mass, what the lumped dynamics conserves,
+/// as for the plug), the contact force on it in the last step
+/// (`Σ f_contact` over its particles: every pair, rigid or deformable, that
+/// touched it) and the number of those pairs
+/// ([`ContactSystem::contacts_touching`]; 0 without a contact stage). The
+/// work fields are 0 (its contact work is in
+/// [`ContactSystem::contact_work`]).
+pub fn deformable_sample(
+    particles: &Particles,
+    f_contact: &[Vec2],
+    body: u32,
+    contact: Option<&ContactSystem>,
+) -> BodySample {
+    let (mut mass, mut moment, mut momentum, mut force) = (0.0, Vec2::zeros(), Vec2::zeros(), Vec2::zeros());
+    for i in (0..particles.len()).filter(|&i| particles.body[i] == body) {
+        let m = particles.mass[i];
+        mass += m;
+        moment += (particles.x0[i] + particles.u[i]) * m;
+        momentum += particles.v[i] * m;
+        force += f_contact.get(i).copied().unwrap_or_else(Vec2::zeros);
+    }
+    let mass: Real = mass.max(Real::MIN_POSITIVE);
+    BodySample {
+        position: moment / mass,
+        velocity: momentum / mass,
+        contact_force: force,
+        work_on_particles: 0.0,
+        work_on_body: 0.0,
+        active_contacts: contact.map_or(0, |c| c.contacts_touching(&particles.body, body)),
+    }
 }
