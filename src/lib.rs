@@ -27,5 +27,6 @@ pub mod residual;
 pub mod run;
 pub mod shape;
 pub mod step;
+pub mod taylor;
 pub mod thermal;
 pub mod validation;
