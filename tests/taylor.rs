@@ -68,3 +68,17 @@ fn impact_face_peak_plastic_strain_stays_near_the_interior() {
     assert!(m.face_peak_plastic_strain < 1.1 * m.interior_peak_plastic_strain, "{m:?}");
     assert!((m.peak_plastic_strain - reference).abs() < 0.1 * reference, "{m:?}");
 }
+
+/// Every shipped Taylor case runs, shortened to 3 µs at 0.4 mm with its own
+/// settings: the bar has met the wall, shortened and widened at the face,
+/// and the face heated by plastic work.
+#[test]
+fn every_taylor_case_runs_shortened() {
+    for t in TAYLOR_TESTS {
+        let o = run_test(t, ("coarse", 0.4e-3), &["time.end=3e-6".to_string()]);
+        assert!(o.failure.is_none(), "{}: {:?}", t.case, o.failure);
+        let m = o.measurement.unwrap();
+        assert!(m.final_length < t.length && m.face_diameter > t.diameter, "{}: {m:?}", t.case);
+        assert!(m.face_peak_plastic_strain > 0.0 && m.peak_temperature > 295.0, "{}: {m:?}", t.case);
+    }
+}
