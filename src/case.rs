@@ -369,9 +369,11 @@ impl Default for HeatSpec {
 pub struct TimeSpec {
     /// End time, s (> 0).
     pub end: Real,
-    /// CFL safety factor s in `Δt = s · min h / c_L`, in (0, 1]. Default 0.5
+    /// CFL safety factor s in `Δt₀ = s · min h / c_L`, in (0, 1]. Default 0.5
     /// (SPEC §5): half the 1D stability limit leaves room for the 2D
-    /// stencil and the stiffening of compressed material.
+    /// stencil. The step then follows the model's stiffness from `Δt₀`
+    /// down ([`crate::stability`]: split crack particles, compressed
+    /// material).
     #[serde(default = "half")]
     pub safety_factor: Real,
     /// A fixed step, s, overriding the CFL rule (\[RL10\] used 4e-9 s).

@@ -53,9 +53,10 @@
 //! it cannot read; the length and the checksum are checked before anything
 //! is decoded. A reader refuses every version but its own
 //! ([`CheckpointError::Version`]): versions 1 to 3 were hand-written
-//! sections of columns, versions 4 to 6 the postcard encoding (5 adds the
+//! sections of columns, versions 4 to 7 the postcard encoding (5 adds the
 //! run's fastest particle, 6 the crack-tip allowance, the crack stage's last
-//! time and the non-local fracture parameters, issue #19). The payload is
+//! time and the non-local fracture parameters, issue #19, 7 the adaptive
+//! stable step). The payload is
 //! [postcard](https://docs.rs/postcard) 1.x, whose wire format is stable
 //! within the major version: fields in declaration order, no names; an
 //! `f64` as its eight IEEE-754 bytes, so values (NaN payloads, −0.0)
@@ -124,8 +125,9 @@ pub const MAGIC: [u8; 8] = *b"PLUGCKPT";
 /// version 3 the deformation-gradient jumps carried over crack changes);
 /// version 4 is the postcard encoding of the serde-derived state, version
 /// 5 adds the run's fastest particle (`Simulation::fastest`), version 6 the
-/// crack-tip allowance and the non-local fracture parameters.
-pub const FORMAT_VERSION: u32 = 6;
+/// crack-tip allowance and the non-local fracture parameters, version 7
+/// the adaptive stable step (`Simulation::stable`, `dt_previous`).
+pub const FORMAT_VERSION: u32 = 7;
 /// Subdirectory of a run's output directory that holds its checkpoints.
 pub const DIRECTORY: &str = "checkpoints";
 /// File name extension of a checkpoint.

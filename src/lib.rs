@@ -26,6 +26,7 @@ pub mod quadrature;
 pub mod residual;
 pub mod run;
 pub mod shape;
+pub mod stability;
 pub mod step;
 pub mod taylor;
 pub mod thermal;

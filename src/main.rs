@@ -786,6 +786,14 @@ fn drive(
     let total = s.setup_wall + s.loop_wall + s.output_wall;
     println!("plugsim run finished: {} steps to t = {:.4e} s (dt = {:.3e} s)", s.steps, s.time, s.dt);
     println!("  particles / quadrature points  {} / {}", s.particles, s.quadrature_points);
+    if let Some((base, (smallest, at, particle))) = s.stable_step {
+        if smallest < base {
+            println!(
+                "  time step: {base:.3e} s from the spacing, down to {smallest:.3e} s at {:.3} us for particle {particle}'s stiffness (history.csv: dt)",
+                at * 1e6
+            );
+        }
+    }
     println!(
         "  energy: kinetic {:.4e} J (rigid {:.4e} J), internal {:.4e} J, contact dissipation {:.4e} J, drift {:+.3} % (max {:.3} %)",
         s.energies.kinetic,
@@ -857,7 +865,7 @@ fn drive(
     }
     if s.eroded_points > 0 {
         println!(
-            "  eroded: {} quadrature points inverted after meeting the crack criterion and carry no stress (history.csv: eroded_points)",
+            "  eroded: {} quadrature points inverted after meeting the crack criterion, or were torn open after fracturing, and carry no stress (history.csv: eroded_points)",
             s.eroded_points
         );
     }

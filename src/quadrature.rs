@@ -47,7 +47,8 @@ pub struct QuadraturePoints {
     /// The carried jumps, one per point that has one (few: the points next
     /// to crack paths).
     pub f_carry: Vec<Tensor3>,
-    /// Eroded: the point inverted after meeting the crack criterion and
+    /// Eroded: the point inverted after meeting the crack criterion, or
+    /// was torn open after fracturing (`crate::material::TORN_VOLUME_RATIO`), and
     /// carries no stress from then on (`crate::fracture` module doc).
     pub eroded: Vec<bool>,
 }

@@ -77,6 +77,10 @@ pub struct RunSummary {
     pub steps: u64,
     pub time: Real,
     pub dt: Real,
+    /// The adaptive step ([`crate::stability::StableStep`]): the rule's
+    /// step and the smallest taken (step, time, particle); `None` with a
+    /// fixed step.
+    pub stable_step: Option<(Real, (Real, Real, usize))>,
     pub snapshots: usize,
     pub setup_wall: Duration,
     pub loop_wall: Duration,
@@ -524,6 +528,7 @@ fn time_loop(
         steps: sim.step,
         time: sim.time,
         dt: sim.dt,
+        stable_step: sim.stable.as_ref().map(|s| (s.base, s.smallest)),
         snapshots: out.snapshots,
         setup_wall,
         loop_wall,

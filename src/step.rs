@@ -9,6 +9,7 @@ use crate::math::{is_block_2d, Block2, InPlane, Real, Tensor3, Vec2};
 use crate::model::{constrain, Model, PARALLEL_PIECE};
 use crate::particles::ParticleFlags;
 use crate::quadrature::NO_CARRY;
+use crate::stability::StableStep;
 use crate::thermal::{HeatConduction, HeatError};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -229,6 +230,11 @@ pub struct Simulation {
     pub f_contact: Vec<Vec2>,
     /// Crack growth (SPEC §9), if the case has a fracture criterion.
     pub cracks: Option<CrackGrowth>,
+    /// The adaptive stable step ([`crate::stability`]); `None` with a
+    /// fixed step.
+    pub stable: Option<StableStep>,
+    /// The step before this one, s (`dt` at the first step).
+    pub dt_previous: Real,
     /// Per-point internal-energy increments of the last step (scratch; this
     /// and `kinetic_scratch` are not in checkpoints: each step resizes and
     /// rewrites them before reading them).
@@ -267,7 +273,13 @@ impl Simulation {
             let (f, v) = (model.particles.flags[i], model.particles.v[i]);
             (f.has(ParticleFlags::FIX_X) && v.x != 0.0) || (f.has(ParticleFlags::FIX_Y) && v.y != 0.0)
         });
+        let stable = match rule {
+            TimeStepRule::Cfl { .. } => Some(StableStep::new(&model, dt)),
+            TimeStepRule::Fixed(_) => None,
+        };
         Simulation {
+            stable,
+            dt_previous: dt,
             model,
             time: 0.0,
             step: 0,
@@ -330,7 +342,7 @@ impl Simulation {
         let (increment, ()) = rayon::join(|| work.iter().sum::<Real>(), || internal_force(&mut self.model));
         self.energies.internal += increment;
         let t3 = Instant::now();
-        self.grow_cracks(dt)?;
+        let cracked = self.grow_cracks(dt)?;
         let t3c = Instant::now();
         self.time += dt;
         self.step += 1;
@@ -342,6 +354,8 @@ impl Simulation {
         self.energies.kinetic = kinetic;
         self.record_fastest();
         self.check_energy()?;
+        self.dt_previous = dt;
+        self.adapt_time_step(cracked);
         let t4 = Instant::now();
         self.timers.contact += t0 - tc;
         self.timers.integration += t1 - t0;
@@ -355,10 +369,10 @@ impl Simulation {
 
     /// Crack growth at `t + Δt`; after a change the new crack-face
     /// particles join the contact slaves and the internal force is
-    /// recomputed with the patched table.
-    fn grow_cracks(&mut self, dt: Real) -> Result<(), SolverError> {
+    /// recomputed with the patched table. Whether the cracks changed.
+    fn grow_cracks(&mut self, dt: Real) -> Result<bool, SolverError> {
         let Some(cracks) = self.cracks.as_mut() else {
-            return Ok(());
+            return Ok(false);
         };
         let (step, time) = (self.step + 1, self.time + dt);
         let faces = cracks.grow(&mut self.model, time, step).map_err(|source| SolverError::Fracture {
@@ -367,7 +381,7 @@ impl Simulation {
             time,
         })?;
         if faces.is_empty() {
-            return Ok(());
+            return Ok(false);
         }
         if let Some(contact) = self.contact.as_mut() {
             for i in faces {
@@ -375,7 +389,30 @@ impl Simulation {
             }
         }
         internal_force(&mut self.model);
-        Ok(())
+        Ok(true)
+    }
+
+    /// Re-evaluate the stable step after a crack change and every
+    /// [`StableStep::every`] steps ([`crate::stability`]); a new step takes
+    /// effect from the next step on ([`Simulation::integrate`]).
+    fn adapt_time_step(&mut self, cracked: bool) {
+        let every = self.stable.as_ref().map_or(u64::MAX, |s| s.every);
+        if cracked || self.step.is_multiple_of(every) {
+            self.refresh_time_step();
+        }
+    }
+
+    /// Re-evaluate the stable step now (with the adaptive rule; a fixed
+    /// step stays), as the time loop does after every crack change: for a
+    /// change of the model made outside the loop.
+    pub fn refresh_time_step(&mut self) {
+        let Some(stable) = self.stable.as_mut() else {
+            return;
+        };
+        let fracturing =
+            self.cracks.as_ref().is_some_and(|c| c.params.critical_value().is_some() && c.params.fractures_points());
+        let dt = stable.evaluate(&self.model, self.time, fracturing);
+        self.dt = dt;
     }
 
     /// Contact forces of this step into `f_contact` (zero without contact).
@@ -386,7 +423,8 @@ impl Simulation {
         let p = &self.model.particles;
         contact.admit_exposed(&p.x0, &p.u, &p.spacing);
         self.f_contact.resize(p.len(), Vec2::zeros());
-        let input = StepInput::from_particles(p, Some(&self.model.particle_shape), dt);
+        let dt_v = 0.5 * (self.dt_previous + dt);
+        let input = StepInput::from_particles(p, Some(&self.model.particle_shape), dt).with_velocity_step(dt_v);
         contact.compute_forces(&input, &mut self.f_contact).map_err(|source| SolverError::Contact {
             source,
             step: self.step + 1,
@@ -417,8 +455,15 @@ impl Simulation {
         Ok(())
     }
 
-    /// Central-difference update of velocities and displacements.
+    /// Central-difference update of velocities and displacements,
+    /// `V^{n+½} = V^{n−½} + ½ (Δt_{n−½} + Δt_{n+½}) a^n`,
+    /// `U^{n+1} = U^n + Δt_{n+½} V^{n+½}` (second order across a change of
+    /// step too; with a constant step, `V += Δt a`, `U += Δt V`). The
+    /// contact stage removes its penetration with `Δt_{n+½}` for both: on
+    /// the step after a change, its force moves the slave by the ratio of
+    /// the two, a few per cent at most, and the next step removes the rest.
     fn integrate(&mut self, dt: Real) {
+        let dt_v = 0.5 * (self.dt_previous + dt);
         let p = &mut self.model.particles;
         if self.f_contact.len() != p.len() {
             self.f_contact.resize(p.len(), Vec2::zeros());
@@ -438,7 +483,7 @@ impl Simulation {
                 let mut acc = (fe + fc - fi) / *m;
                 constrain(*flags, &mut acc);
                 *a = acc;
-                *v += acc * dt;
+                *v += acc * dt_v;
                 *u += *v * dt;
             });
     }
@@ -523,6 +568,14 @@ impl Simulation {
                 }
                 _ => return Some((qi, J)),
             };
+            if fracturing && c.damage[k] >= 1.0 && J >= crate::material::TORN_VOLUME_RATIO {
+                // Torn open (`crate::material::TORN_VOLUME_RATIO`): eroded.
+                c.eroded[k] = true;
+                c.tau[k] = Block2::zeros();
+                c.set_pw(k, &Block2::zeros());
+                c.work[k] = 0.0;
+                return None;
+            }
             let old = crate::material::PointState {
                 tau: c.tau[k].to_tensor(),
                 eps_p: c.eps_p[k],

@@ -392,20 +392,19 @@ fn checkpoint_of_another_format_version_is_refused_naming_both() {
     }
 }
 
-/// Format 4 (postcard, before the fastest particle, the crack-tip
-/// allowance and the non-local fracture parameters) is refused, naming both versions, rather than
-/// misread.
+/// Format 6 (postcard, before the adaptive stable step) is refused,
+/// naming both versions, rather than misread.
 #[test]
 fn older_format_version_checkpoint_is_refused_naming_both_versions() {
-    assert_eq!(FORMAT_VERSION, 6);
+    assert_eq!(FORMAT_VERSION, 7);
     let case = case(STRIKE, &["time.end=1e-6"]);
-    let dir = scratch("version-4");
+    let dir = scratch("version-6");
     let path = run_until(&case, &dir, 2);
-    corrupt(&path, 8, &4u32.to_le_bytes());
+    corrupt(&path, 8, &6u32.to_le_bytes());
     let e = checkpoint::read(&path).unwrap_err().to_string();
-    assert!(e.contains("format version 4 ") && e.contains("reads format version 6"), "{e}");
+    assert!(e.contains("format version 6 ") && e.contains("reads format version 7"), "{e}");
     let e = resume(&config(&dir, None), &mut |_| {}).unwrap_err().to_string();
-    assert!(e.contains("format version 4 ") && e.contains("format version 6"), "{e}");
+    assert!(e.contains("format version 6 ") && e.contains("format version 7"), "{e}");
 }
 
 #[test]

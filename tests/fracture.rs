@@ -733,6 +733,36 @@ fn inverted_failed_points_are_eroded_and_others_stop_the_run() {
     assert!((x - centre).norm() < 3.5 * H, "{x:?}");
 }
 
+/// Fractured points (`D ≥ 1`, cracks growing) that are torn open beyond
+/// `TORN_VOLUME_RATIO` (`J ≥ 1.05`) are eroded: their deformation
+/// gradient no longer describes a continuum, and its `J` can swing toward
+/// zero in one step (`material::TORN_VOLUME_RATIO`). Opened less, or not
+/// fractured, they are not.
+#[test]
+fn torn_fractured_points_are_eroded() {
+    let centre = Vec2::new(5.0 * H, 5.0 * H);
+    let eroded_after_one_step = |stretch: Real, damage: Real| {
+        let mut m = plate(11, 11);
+        // A uniform dilation, J = (1 + stretch)², at rest.
+        for i in 0..m.particles.len() {
+            m.particles.u[i] = (m.particles.x0[i] - centre) * stretch;
+        }
+        m.quad.damage.fill(damage);
+        let mut sim = Simulation::new(m, TimeStepRule::Cfl { safety: 0.5 });
+        sim.cracks = Some(CrackGrowth::new(params(Criterion::Damage)));
+        sim.step().unwrap();
+        let q = &sim.model.quad;
+        let eroded = q.eroded.iter().filter(|&&e| e).count();
+        assert!((0..q.len()).filter(|&k| q.eroded[k]).all(|k| q.tau[k] == Block2::zeros()));
+        (eroded, q.len())
+    };
+    assert!(1.03f64.powi(2) >= plugsim::material::TORN_VOLUME_RATIO);
+    let (eroded, all) = eroded_after_one_step(0.03, 1.2);
+    assert_eq!(eroded, all, "every point torn to J = 1.061 is eroded");
+    assert_eq!(eroded_after_one_step(0.02, 1.2).0, 0, "J = 1.040: open, not torn");
+    assert_eq!(eroded_after_one_step(0.03, 0.9).0, 0, "not fractured");
+}
+
 /// The crack-tip speed limit of `"nonlocal_damage"` (`fracture::tip_speed`):
 /// a column of material failed everywhere (Johnson–Cook damage 5) down a
 /// tall plate. Limited to the Rayleigh speed `c_R`, the tip's path after

@@ -78,13 +78,15 @@ pub enum Spreading {
 /// Normal force along `n_m` that removes the gap `g` of a point of effective
 /// mass `mass` (kg) in one step: `f_n = −m g / Δt²`, i.e. `m |g| / Δt²` for a
 /// penetration (SPEC §8, [RL10, §3] with the factor of SPEC §5's half-step
-/// velocities: module doc, # Deviations). Negative for an open gap; the
-/// caller keeps the total normal force non-negative. An infinite mass (a
-/// point that cannot move) gives no force.
+/// velocities: module doc, # Deviations). `dt2` is `Δt Δt_v`, the product
+/// of the step's displacement and velocity steps (`Δt²` unless the step
+/// just changed: a force `f` moves the point by `Δt Δt_v f / m`). Negative
+/// for an open gap; the caller keeps the total normal force non-negative.
+/// An infinite mass (a point that cannot move) gives no force.
 #[inline]
-pub fn one_step_normal_force(mass: Real, gap: Real, dt: Real) -> Real {
+pub fn one_step_normal_force(mass: Real, gap: Real, dt2: Real) -> Real {
     if mass.is_finite() {
-        -mass * gap / (dt * dt)
+        -mass * gap / dt2
     } else {
         0.0
     }
@@ -143,8 +145,8 @@ mod tests {
 
     #[test]
     fn one_step_forces_and_the_coulomb_cap() {
-        assert!((one_step_normal_force(2.0, -1e-9, 1e-6) - 2.0e3).abs() < 1e-9);
-        assert!(one_step_normal_force(2.0, 1e-9, 1e-6) < 0.0);
+        assert!((one_step_normal_force(2.0, -1e-9, 1e-12) - 2.0e3).abs() < 1e-9);
+        assert!(one_step_normal_force(2.0, 1e-9, 1e-12) < 0.0);
         assert_eq!(one_step_normal_force(Real::INFINITY, -1.0, 1.0), 0.0);
         assert_eq!(stick_force(1.0, -1e-3, 1e-3), 1.0);
         // stick below the cap, slip at the cap with the trial's sign above it

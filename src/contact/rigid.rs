@@ -200,12 +200,14 @@ impl RigidBody {
     }
 
     /// Advance one step under the total force `force` (N) acting on it:
-    /// `V ← V + Δt F/M`, `x ← x + Δt V` (the particles' central difference,
-    /// SPEC §5); a prescribed velocity overrides `V`.
-    pub fn advance(&mut self, force: Vec2, dt: Real) {
+    /// `V ← V + Δt_v F/M`, `x ← x + Δt V` (the particles' central
+    /// difference, SPEC §5, with its velocity step `Δt_v`, which differs
+    /// from `Δt` on the step after a change of step); a prescribed velocity
+    /// overrides `V`.
+    pub fn advance(&mut self, force: Vec2, dt_velocity: Real, dt: Real) {
         self.velocity = match self.prescribed_velocity {
             Some(v) => v,
-            None => self.velocity + force * (dt / self.mass),
+            None => self.velocity + force * (dt_velocity / self.mass),
         };
         if self.on_axis {
             self.velocity.x = 0.0;
@@ -475,11 +477,11 @@ mod tests {
     #[test]
     fn advance_is_central_difference_and_prescribed_overrides() {
         let mut b = RigidBody::new("p", rectangle_outline(1.0, 1.0), Vec2::zeros(), Vec2::new(1.0, 0.0), 2.0).unwrap();
-        b.advance(Vec2::new(4.0, -2.0), 0.5);
+        b.advance(Vec2::new(4.0, -2.0), 0.5, 0.5);
         assert_eq!(b.velocity, Vec2::new(2.0, -0.5));
         assert_eq!(b.position, Vec2::new(1.0, -0.25));
         let mut w = b.clone().with_prescribed_velocity(Vec2::new(0.0, -3.0));
-        w.advance(Vec2::new(1e9, 1e9), 0.5);
+        w.advance(Vec2::new(1e9, 1e9), 0.5, 0.5);
         assert_eq!(w.velocity, Vec2::new(0.0, -3.0));
         assert_eq!(w.position, Vec2::new(1.0, -1.75));
     }

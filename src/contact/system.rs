@@ -120,8 +120,11 @@ pub struct StepInput<'a> {
     /// Shape functions at the particles, `N_J(X_I)` in row `I`; needed by
     /// [`Spreading::InverseDistance`] and [`Spreading::ShapeFunction`].
     pub shape: Option<&'a ShapeTable>,
-    /// Time step `Δt`, s.
+    /// Time step `Δt = Δt_{n+½}`, s: the displacement step.
     pub dt: Real,
+    /// The velocity step `½ (Δt_{n−½} + Δt_{n+½})`, s: `Δt` unless the
+    /// step just changed (`Simulation::integrate`).
+    pub dt_velocity: Real,
 }
 
 impl<'a> StepInput<'a> {
@@ -140,7 +143,13 @@ impl<'a> StepInput<'a> {
             flags: &p.flags,
             shape,
             dt,
+            dt_velocity: dt,
         }
+    }
+
+    /// The same input with the velocity step `dt_velocity`.
+    pub fn with_velocity_step(self, dt_velocity: Real) -> Self {
+        Self { dt_velocity, ..self }
     }
 
     fn validate(&self, spreading: Spreading) -> Result<(), ContactError> {
@@ -162,6 +171,9 @@ impl<'a> StepInput<'a> {
         }
         if !(self.dt.is_finite() && self.dt > 0.0) {
             return Err(ContactError::InvalidParameter { name: "dt", value: self.dt });
+        }
+        if !(self.dt_velocity.is_finite() && self.dt_velocity > 0.0) {
+            return Err(ContactError::InvalidParameter { name: "dt_velocity", value: self.dt_velocity });
         }
         if spreading != Spreading::None {
             let table = self.shape.ok_or(ContactError::MissingShapeTable { spreading })?;
@@ -189,7 +201,7 @@ impl<'a> StepInput<'a> {
             return Err(ContactError::InvalidParticle { particle: j, field: "mass", value: m });
         }
         let flags = self.flags[j];
-        let mut v = self.v[j] + (self.force_external[j] - self.force_internal[j]) * (self.dt / m);
+        let mut v = self.v[j] + (self.force_external[j] - self.force_internal[j]) * (self.dt_velocity / m);
         flags.constrain(&mut v);
         Ok((self.u[j] + v * self.dt, v))
     }
@@ -272,9 +284,9 @@ pub struct ContactSystem {
     /// Cumulative contact work per body on the particles and on the body, J.
     work_on_particles: Vec<Real>,
     work_on_body: Vec<Real>,
-    /// `Δt` and particle count of a `compute_forces` not yet followed by
+    /// `Δt`, `Δt_v` and particle count of a `compute_forces` not yet followed by
     /// `advance`.
-    pending: Option<(Real, usize)>,
+    pending: Option<(Real, Real, usize)>,
     /// Scratch: (particle, weight) rows of the gap points and, for
     /// inverse-distance spreading, of the forces; the pairs being solved.
     /// Not in checkpoints (this and `gap_points`): cleared, or resized and
@@ -497,7 +509,7 @@ impl ContactSystem {
         self.force_w.clear();
         self.reaction.fill(Vec2::zeros());
         self.active_per_body.fill(0);
-        let dt = input.dt;
+        let (dt, dt_v) = (input.dt, input.dt_velocity);
         for (b, body) in self.bodies.iter().enumerate() {
             self.predicted_position[b] = body.position + body.predicted_velocity() * dt;
         }
@@ -615,10 +627,10 @@ impl ContactSystem {
                 for &(j, w) in &self.gap_w[c.gap_rows.0 as usize..c.gap_rows.1 as usize] {
                     du += mobility(input, j as usize).component_mul(&f_contact[j as usize]) * w;
                 }
-                let gap = c.gap + dt * dt * c.normal.dot(&du);
-                let f_n = (c.f_n + one_step_normal_force(c.mass_normal, gap, dt)).max(0.0);
-                let v_t = c.slip_velocity + dt * c.tangent.dot(&du);
-                let (f_t, slipping) = coulomb_cap(c.f_t + stick_force(c.mass_tangent, v_t, dt), mu * f_n);
+                let gap = c.gap + dt * dt_v * c.normal.dot(&du);
+                let f_n = (c.f_n + one_step_normal_force(c.mass_normal, gap, dt * dt_v)).max(0.0);
+                let v_t = c.slip_velocity + dt_v * c.tangent.dot(&du);
+                let (f_t, slipping) = coulomb_cap(c.f_t + stick_force(c.mass_tangent, v_t, dt_v), mu * f_n);
                 let delta = c.normal * (f_n - c.f_n) + c.tangent * (f_t - c.f_t);
                 if delta != Vec2::zeros() {
                     let rows = if id { &self.force_w[..] } else { &self.gap_w[..] };
@@ -672,7 +684,7 @@ impl ContactSystem {
                 force: applied,
             });
         }
-        self.pending = Some((dt, n));
+        self.pending = Some((dt, dt_v, n));
         Ok(StepReport { active_contacts: self.contacts.len(), force_on_particles: total, iterations })
     }
 
@@ -693,7 +705,7 @@ impl ContactSystem {
     /// the same way to close the energy balance of SPEC §5. Test:
     /// `momentum_and_energy_with_a_free_body`.
     pub fn advance(&mut self, v: &[Vec2]) -> Result<(), ContactError> {
-        let (dt, n) = self.pending.ok_or(ContactError::AdvanceWithoutForces)?;
+        let (dt, dt_v, n) = self.pending.ok_or(ContactError::AdvanceWithoutForces)?;
         if v.len() != n {
             return Err(ContactError::LengthMismatch { field: "v", expected: n, found: v.len() });
         }
@@ -701,12 +713,12 @@ impl ContactSystem {
         self.resize_per_body(); // bodies added since compute_forces feel no force
         for &(j, b, f, v_old) in &self.applied {
             let v_new = v[j as usize];
-            self.work_on_particles[b as usize] += 0.5 * dt * f.dot(&(v_old + v_new));
+            self.work_on_particles[b as usize] += 0.5 * dt_v * f.dot(&(v_old + v_new));
         }
         for (b, body) in self.bodies.iter_mut().enumerate() {
             let v_old = body.velocity;
-            body.advance(self.reaction[b], dt);
-            self.work_on_body[b] += 0.5 * dt * self.reaction[b].dot(&(v_old + body.velocity));
+            body.advance(self.reaction[b], dt_v, dt);
+            self.work_on_body[b] += 0.5 * dt_v * self.reaction[b].dot(&(v_old + body.velocity));
         }
         Ok(())
     }

@@ -124,6 +124,30 @@ pub fn fractured(mut s: PointState, jacobian: Real) -> PointState {
     s
 }
 
+/// Volume ratio `J` beyond which a fractured point (`D ≥ 1`, while cracks
+/// grow) is torn open: the solver erodes it, and it carries no stress from
+/// then on, closed or not.
+///
+/// # Deviations
+/// [`fractured`] lets an opened point carry pressure again once it closes
+/// (`J < 1`). Material that has opened by 5 % in volume is no continuum any
+/// more: the particles its deformation gradient is interpolated from have
+/// been torn apart, `F` is nearly singular (in the coarse axisymmetric
+/// Borvik Case I at 72 µs, points behind the ring crack had `J` from 1.09
+/// to 13 and singular-value ratios of `F` up to 1,000), and its `J`, a
+/// difference of large products, can swing from above 1 to near 0 in one
+/// step of an ordinary displacement. There the closure pressure
+/// `K |ln J|` reached hundreds of GPa: a surface particle beside the crack
+/// took 3·10⁸ N in one step at 98 µs, and the energy balance went from
+/// 8.7 kJ to 518 kJ (an energy blow-up, with the step of
+/// [`crate::stability`]; the fixed step of the spacing had missed it by
+/// chance). A torn point's closure is the meeting of two crack faces,
+/// which is contact's work, not the point's. 5 % is far beyond the elastic
+/// dilatation of steel (`p/K ≈ 1 GPa / 167 GPa = 0.6 %`), so no intact or
+/// merely damaged point is eroded by it. Test:
+/// `torn_fractured_points_are_eroded` (tests/fracture.rs).
+pub const TORN_VOLUME_RATIO: Real = 1.05;
+
 /// Every constitutive model the solver knows.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Material {
