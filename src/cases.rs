@@ -148,6 +148,41 @@ pub const BUILTIN_CASES: &[(&str, &str, &str)] = &[
         include_str!("../cases/borvik-1-nofracture.toml"),
         "Borvik Case I (298 m/s, 11.1 mm Weldox), plane strain, coarse, no fracture",
     ),
+    (
+        "taylor-cu-130",
+        include_str!("../cases/taylor-cu-130.toml"),
+        "Taylor anvil test: OFHC copper, 130 m/s, axisymmetric, rigid wall",
+    ),
+    (
+        "taylor-cu-146",
+        include_str!("../cases/taylor-cu-146.toml"),
+        "Taylor anvil test: OFHC copper, 146 m/s, axisymmetric, rigid wall",
+    ),
+    (
+        "taylor-cu-190",
+        include_str!("../cases/taylor-cu-190.toml"),
+        "Taylor anvil test: OFHC copper, 190 m/s, axisymmetric, rigid wall",
+    ),
+    (
+        "taylor-4340-208",
+        include_str!("../cases/taylor-4340-208.toml"),
+        "Taylor anvil test: 4340 steel, 208 m/s, L0 = 25.4 mm, axisymmetric, rigid wall",
+    ),
+    (
+        "taylor-4340-282",
+        include_str!("../cases/taylor-4340-282.toml"),
+        "Taylor anvil test: 4340 steel, 282 m/s, L0 = 12.7 mm, axisymmetric, rigid wall",
+    ),
+    (
+        "taylor-4340-343",
+        include_str!("../cases/taylor-4340-343.toml"),
+        "Taylor anvil test: 4340 steel, 343 m/s, L0 = 8.1 mm, axisymmetric, rigid wall",
+    ),
+    (
+        "taylor-42crmo4-287",
+        include_str!("../cases/taylor-42crmo4-287.toml"),
+        "Taylor anvil test: 42CrMo4 steel, 287 m/s (DynELA/Abaqus benchmark), axisymmetric, rigid wall",
+    ),
 ];
 
 /// Børvik et al.'s nose-shape experiments (IJIE 27, 2002; the reference

@@ -28,5 +28,6 @@ pub mod run;
 pub mod shape;
 pub mod stability;
 pub mod step;
+pub mod taylor;
 pub mod thermal;
 pub mod validation;

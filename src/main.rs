@@ -75,6 +75,15 @@ enum Command {
         /// of stopping 20 us after the projectile's release.
         #[arg(long)]
         full_time: bool,
+        /// Which family: borvik (the plugging cases) or taylor (the Taylor
+        /// anvil tests, taylor-*: coarse and medium resolutions, fine with --all;
+        /// --only selects among their case names).
+        #[arg(long, default_value = "borvik")]
+        family: String,
+        /// Override a value of every Taylor run (taylor family only), e.g.
+        /// time.safety_factor=0.1; written into the report.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
     },
     /// Run a case with a rigid projectile at several impact speeds and/or find
     /// its ballistic limit by bisection; writes ballistic.csv, ballistic.md
@@ -251,7 +260,12 @@ fn dispatch(cmd: Command) -> Result<()> {
             ballistic(case, &name, &file, &set, out, args)
         }
         Command::Bench { case, steps, whole, set } => bench(&case, steps, whole, &set),
-        Command::Validate { out, all, only, full_time } => validate(&out, all, only.as_deref(), full_time),
+        Command::Validate { out, all, only, full_time, family, set } => match family.as_str() {
+            "borvik" if set.is_empty() => validate(&out, all, only.as_deref(), full_time),
+            "borvik" => bail!("--set applies to the taylor family only"),
+            "taylor" => validate_taylor(&out, all, only.as_deref(), &set),
+            other => bail!("unknown validation family `{other}` (borvik or taylor)"),
+        },
         Command::MaterialPoint { material, case_file, path, rate, strain, dt, out } => {
             material_point(&material, case_file.as_deref(), path, rate, strain, dt, &out)
         }
@@ -394,6 +408,54 @@ fn validate(out: &Path, all: bool, only: Option<&str>, full_time: bool) -> Resul
     std::fs::write(out.join("validation.csv"), &csv)?;
     println!("{md}");
     println!("written: {0}/validation.md, {0}/validation.csv and the plots beside them", out.display());
+    Ok(())
+}
+
+/// `plugsim validate --family taylor`: the Taylor anvil tests at two (three
+/// with `--all`) resolutions, table, CSV and profile plots into `out`.
+fn validate_taylor(out: &Path, all: bool, only: Option<&str>, set: &[String]) -> Result<()> {
+    use plugsim::taylor::{profile_plot, run_test, table, METHODS, RESOLUTIONS, TAYLOR_TESTS};
+    let tests: Vec<_> = TAYLOR_TESTS.iter().filter(|t| only.is_none_or(|o| t.case.contains(o))).collect();
+    if tests.is_empty() {
+        bail!("no Taylor test matches {only:?} (see `plugsim cases`, the taylor-* names)");
+    }
+    let resolutions = if all { &RESOLUTIONS[..] } else { &RESOLUTIONS[..2] };
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    let total = tests.len() * resolutions.len();
+    eprintln!("plugsim validate --family taylor: {total} runs into {}", out.display());
+    let mut outcomes = Vec::new();
+    for t in &tests {
+        for &r in resolutions {
+            eprintln!("  [{}/{total}] {} {} ...", outcomes.len() + 1, t.case, r.0);
+            let o = run_test(t, r, set);
+            eprintln!(
+                "        {:.1} s{}",
+                o.wall,
+                o.failure.as_ref().map(|(t, e)| format!(", stopped at {:.2} us: {e}", t * 1e6)).unwrap_or_default()
+            );
+            outcomes.push(o);
+        }
+    }
+    let (md, csv) = table(&outcomes);
+    let mut plots = String::new();
+    for t in &tests {
+        let name = format!("profile_{}.png", t.case);
+        plugsim::io::save_line_plot(&out.join(&name), &profile_plot(&outcomes, t))?;
+        plots.push_str(&format!("![{}]({name})\n", t.case));
+    }
+    let header = format!(
+        "Produced by `plugsim validate --family taylor` ({} {}) on {}, {} threads; overrides: {}.",
+        env!("CARGO_PKG_VERSION"),
+        env!("PLUGSIM_COMMIT"),
+        cpu_name(),
+        rayon::current_num_threads(),
+        if set.is_empty() { "none (the case files' settings)".to_string() } else { set.join(" ") }
+    );
+    let report = format!("{header}\n\n{md}\n{METHODS}\n\n{plots}");
+    std::fs::write(out.join("taylor.md"), &report)?;
+    std::fs::write(out.join("taylor.csv"), &csv)?;
+    println!("{report}");
+    println!("written: {0}/taylor.md, {0}/taylor.csv and the profile plots beside them", out.display());
     Ok(())
 }
 

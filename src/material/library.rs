@@ -1,20 +1,26 @@
 //! Named built-in materials, each citing the table its constants come from.
 //!
-//! Constants are those of `shared/reference/ren-li-2010.toml` (Ren & Li,
-//! Computers and Structures 88 (2010), Table 2, completed by Børvik et al.'s
-//! values for the rows the paper does not print).
+//! Weldox 460 E: the constants of `shared/reference/ren-li-2010.toml` (Ren &
+//! Li, Computers and Structures 88 (2010), Table 2, completed by Børvik et
+//! al.'s values for the rows the paper does not print). The metals of the
+//! Taylor anvil tests (`cases/taylor-*.toml`, [`crate::taylor`]): OFHC
+//! copper and 4340 steel of Johnson & Cook (1983), 42CrMo4 of the DynELA
+//! Taylor benchmark; each function names its source and what it lacks.
 
 use super::johnson_cook::{DamageConstants, JohnsonCook, RateForm};
 use super::Material;
 
 /// Names accepted by [`builtin`], in a stable order.
-pub const NAMES: &[&str] = &["weldox_460e", "weldox_460e_borvik"];
+pub const NAMES: &[&str] = &["weldox_460e", "weldox_460e_borvik", "ofhc_copper", "steel_4340", "steel_42crmo4"];
 
 /// The built-in material called `name`, or `None`.
 pub fn builtin(name: &str) -> Option<Material> {
     match name {
         "weldox_460e" => Some(Material::JohnsonCook(weldox_460e())),
         "weldox_460e_borvik" => Some(Material::JohnsonCook(weldox_460e_borvik())),
+        "ofhc_copper" => Some(Material::JohnsonCook(ofhc_copper())),
+        "steel_4340" => Some(Material::JohnsonCook(steel_4340())),
+        "steel_42crmo4" => Some(Material::JohnsonCook(steel_42crmo4())),
         _ => None,
     }
 }
@@ -70,6 +76,106 @@ pub fn weldox_460e_borvik() -> JohnsonCook {
         rate_form: RateForm::Power,
         thermal_expansion: 1.1e-5,
         ..weldox_460e()
+    }
+}
+
+/// Damage constants of a metal whose Johnson–Cook failure constants the
+/// source does not give: `D₁ = 10³⁰`, the others 0, so the failure strain is
+/// 10³⁰ and the damage stays at 0 (it is only an output here: the Taylor
+/// cases grow no cracks). Not a fit of anything.
+pub const NO_DAMAGE: DamageConstants = DamageConstants { d1: 1.0e30, d2: 0.0, d3: 0.0, d4: 0.0, d5: 0.0 };
+
+/// OFHC copper, Johnson & Cook's 1983 set (the material of their cylinder
+/// impact tests, the Taylor cases `taylor-cu-*`).
+///
+/// Source: G. R. Johnson, W. H. Cook, "A constitutive model and data for
+/// metals subjected to large strains, high strain rates and high
+/// temperatures", Proc. 7th Int. Symp. Ballistics, The Hague (1983)
+/// 541–547, as transcribed with `E = 124 GPa`, `ν = 0.34`, `ρ = 8960 kg/m³`,
+/// `C_p = 383 J/(kg K)` in public simulation inputs that cite it
+/// (`molanocortes/OpenPhysicsAI`, `src/lab/impact/impact_materials.c`,
+/// checked there against LANL LA-UR-22-29965): `A = 90 MPa`, `B = 292 MPa`,
+/// `n = 0.31`, `C = 0.025`, `m = 1.09`, `T_m = 1356 K`, `ε̇₀ = 1 s⁻¹`,
+/// room temperature 294 K. Not in the source, and chosen here: `χ = 0.9`
+/// (the usual Taylor–Quinney value), no thermal expansion and no
+/// conductivity (the Taylor references are adiabatic computations), no
+/// damage ([`NO_DAMAGE`]).
+pub fn ofhc_copper() -> JohnsonCook {
+    JohnsonCook {
+        density: 8960.0,
+        youngs_modulus: 124.0e9,
+        poisson_ratio: 0.34,
+        yield_stress: 90.0e6,
+        hardening_modulus: 292.0e6,
+        hardening_exponent: 0.31,
+        rate_sensitivity: 0.025,
+        softening_exponent: 1.09,
+        melting_temperature: 1356.0,
+        room_temperature: 294.0,
+        reference_strain_rate: 1.0,
+        rate_form: RateForm::Log,
+        specific_heat: 383.0,
+        taylor_quinney: 0.9,
+        thermal_expansion: 0.0,
+        conductivity: 0.0,
+        damage: NO_DAMAGE,
+        damage_coupling: false,
+        theta: JohnsonCook::DEFAULT_THETA,
+    }
+}
+
+/// 4340 steel, Johnson & Cook's 1983 set (the Taylor cases `taylor-4340-*`).
+///
+/// Source: Johnson & Cook (1983) (see [`ofhc_copper`]) as tabulated with
+/// its elastic and thermal constants in a public material table citing it
+/// (stored file id 62562932481, "Johnson & Cook (1983) 7th Int. Symp.
+/// Ballistics"; the same `A, B, n, C, m, T_m` appear, divided by √3, in
+/// `ijd2104/ShearBands`): `A = 792 MPa`, `B = 510 MPa`, `n = 0.26`,
+/// `C = 0.014`, `m = 1.03`, `T_m = 1793 K`, `ρ = 7830 kg/m³`, `E = 207 GPa`,
+/// `ν = 0.29`, `C_p = 477 J/(kg K)`, `ε̇₀ = 1 s⁻¹`. Chosen here as for
+/// [`ofhc_copper`]: `χ = 0.9`, no thermal expansion, no conductivity, no
+/// damage; room temperature 295 K (the tests').
+pub fn steel_4340() -> JohnsonCook {
+    JohnsonCook {
+        density: 7830.0,
+        youngs_modulus: 207.0e9,
+        poisson_ratio: 0.29,
+        yield_stress: 792.0e6,
+        hardening_modulus: 510.0e6,
+        hardening_exponent: 0.26,
+        rate_sensitivity: 0.014,
+        softening_exponent: 1.03,
+        melting_temperature: 1793.0,
+        room_temperature: 295.0,
+        specific_heat: 477.0,
+        ..ofhc_copper()
+    }
+}
+
+/// 42CrMo4 steel of the DynELA Taylor benchmark (`taylor-42crmo4-287`).
+///
+/// Source: O. Pantalé, DynELA v.4.0 documentation,
+/// `Documentation/Samples-Impacts.tex` (`pantale/DynELA-v.-4.0`), the
+/// material table of its Taylor impact: `E = 206.9 GPa`, `ν = 0.3`,
+/// `ρ = 7830 kg/m³`, `A = 806 MPa`, `B = 614 MPa`, `n = 0.168`,
+/// `C = 0.0089`, `m = 1.1`, `ε̇₀ = 1 s⁻¹`, `T₀ = 20 °C`, `T_m = 1540 °C`,
+/// `C_p = 460 J/(kg K)`, conductivity 34 W/(m K), Taylor–Quinney 0.9. Not
+/// given there: thermal expansion (none here) and damage ([`NO_DAMAGE`]).
+pub fn steel_42crmo4() -> JohnsonCook {
+    JohnsonCook {
+        density: 7830.0,
+        youngs_modulus: 206.9e9,
+        poisson_ratio: 0.3,
+        yield_stress: 806.0e6,
+        hardening_modulus: 614.0e6,
+        hardening_exponent: 0.168,
+        rate_sensitivity: 0.0089,
+        softening_exponent: 1.1,
+        melting_temperature: 1540.0 + 273.15,
+        room_temperature: 20.0 + 273.15,
+        specific_heat: 460.0,
+        conductivity: 34.0,
+        ..ofhc_copper()
     }
 }
 

@@ -1,0 +1,478 @@
+//! Taylor anvil tests: a metal bar hits a rigid wall (the built-in cases
+//! `taylor-*`), measured as the experimenters measured the recovered bars
+//! and compared with published experiments and other codes (`plugsim
+//! validate --family taylor`, issue #20).
+//!
+//! What a run measures at its end ([`measure`]), from the physical particle
+//! positions `x(X_I) = X_I + Σ_J N_J(X_I) U_J` (SPEC §2) and the quadrature
+//! points' state:
+//! - **final length**: the bar's extent along its axis, `max y − min y`;
+//! - **face diameter**: twice the largest radius of the particles of the
+//!   impact face (the row `Y = y_min`), the experiments' "mushroom"
+//!   diameter `D_m`;
+//! - **peak plastic strain and temperature**: the largest over the
+//!   quadrature points, and separately the largest over the points of the
+//!   first cell row (the impact face) and over the points at least two
+//!   spacings from the face (the interior): a contact layer that made plastic
+//!   work of its own would show as a face peak above the interior one;
+//! - **profile**: the impact face's particles and the outer column, radius
+//!   against height above the lowest point (the deformed outline the
+//!   experiments digitised).
+//!
+//! Resolutions: [`RESOLUTIONS`] gives each case three particle spacings
+//! (0.4, 0.2 = the case file, 0.1 mm) by overriding the bar's `layers` and
+//! `fine_spacing`, nothing else.
+
+use crate::case::Case;
+use crate::cases::builtin_case;
+use crate::io::{LinePlot, Series};
+use crate::math::{Real, Vec2};
+use crate::model::Model;
+use crate::run::build_simulation;
+use std::time::Instant;
+
+/// A published value of one test: who gives it and what.
+#[derive(Clone, Copy, Debug)]
+pub struct Reference {
+    /// Short source label for the table.
+    pub source: &'static str,
+    /// Whether it is a measurement (false: another code's computation).
+    pub experiment: bool,
+    /// Final length, m.
+    pub final_length: Option<Real>,
+    /// Impact-face (mushroom) diameter, m.
+    pub face_diameter: Option<Real>,
+    /// Peak effective plastic strain.
+    pub peak_plastic_strain: Option<Real>,
+    /// Peak temperature, K.
+    pub peak_temperature: Option<Real>,
+}
+
+/// One Taylor test: a built-in case and its references.
+#[derive(Clone, Copy, Debug)]
+pub struct TaylorTest {
+    /// The built-in case.
+    pub case: &'static str,
+    /// Metal, for the report.
+    pub metal: &'static str,
+    /// Impact speed, m/s.
+    pub impact_velocity: Real,
+    /// Initial length and diameter, m.
+    pub length: Real,
+    pub diameter: Real,
+    pub references: &'static [Reference],
+    /// A digitised deformed outline of the recovered bar, `(radius, height)`
+    /// in mm (none if not found).
+    pub experiment_profile: &'static [(Real, Real)],
+}
+
+/// Johnson & Cook (1983) as tabulated in `bbanerjee/HighRateExptData`
+/// (`TaylorData/MATLAB/plotOFHCCu.m`, `plot4340St.m`): `L_f/L_0` and
+/// `D_m/D_0` or `D_m`, turned into lengths here.
+const JC83: &str = "experiment (Johnson & Cook 1983)";
+
+const fn experiment(final_length: Real, face_diameter: Real) -> Reference {
+    Reference {
+        source: JC83,
+        experiment: true,
+        final_length: Some(final_length),
+        face_diameter: Some(face_diameter),
+        peak_plastic_strain: None,
+        peak_temperature: None,
+    }
+}
+
+/// The Taylor tests and their references (sources in each case file's
+/// header and in docs/validation.md). Lengths from ratios: copper
+/// `L_0 = 25.4 mm`, `D_0 = 7.62 mm`; 4340 `D_0 = 7.62 mm`.
+pub const TAYLOR_TESTS: &[TaylorTest] = &[
+    TaylorTest {
+        case: "taylor-cu-130",
+        metal: "OFHC copper",
+        impact_velocity: 130.0,
+        length: 25.4e-3,
+        diameter: 7.62e-3,
+        references: &[experiment(0.770 * 25.4e-3, 1.30 * 7.62e-3)],
+        // Johnson & Cook (1983) p. 546, digitised in HighRateExptData
+        // (TaylorData/DAT/taylorCuJohnsonCook130.dat).
+        experiment_profile: &[
+            (4.7647, 0.0),
+            (4.5926, 2.067),
+            (4.4636, 4.099),
+            (4.4550, 6.037),
+            (4.4464, 8.181),
+            (4.3604, 10.075),
+            (4.2658, 12.012),
+            (4.2142, 13.993),
+            (4.0766, 15.818),
+            (3.8186, 17.755),
+            (3.8100, 19.649),
+        ],
+    },
+    TaylorTest {
+        case: "taylor-cu-146",
+        metal: "OFHC copper",
+        impact_velocity: 146.0,
+        length: 25.4e-3,
+        diameter: 7.62e-3,
+        references: &[experiment(0.736 * 25.4e-3, 1.40 * 7.62e-3)],
+        experiment_profile: &[],
+    },
+    TaylorTest {
+        case: "taylor-cu-190",
+        metal: "OFHC copper",
+        impact_velocity: 190.0,
+        length: 25.4e-3,
+        diameter: 7.62e-3,
+        references: &[
+            experiment(0.638 * 25.4e-3, 1.78 * 7.62e-3),
+            // molanocortes/OpenPhysicsAI docs/lab/impact.md: its hexahedral
+            // solver with the same Johnson-Cook set, L/L0 = 0.685, D/D0 =
+            // 1.91 (an unreviewed public code; no strain or temperature).
+            Reference {
+                source: "code (OpenPhysicsAI, hexahedra)",
+                experiment: false,
+                final_length: Some(0.685 * 25.4e-3),
+                face_diameter: Some(1.91 * 7.62e-3),
+                peak_plastic_strain: None,
+                peak_temperature: None,
+            },
+        ],
+        experiment_profile: &[],
+    },
+    TaylorTest {
+        case: "taylor-4340-208",
+        metal: "4340 steel",
+        impact_velocity: 208.0,
+        length: 25.4e-3,
+        diameter: 7.62e-3,
+        references: &[experiment(0.885 * 25.4e-3, 11.1e-3)],
+        // HighRateExptData TaylorData/DAT/taylorStJohnsonCook208.dat.
+        experiment_profile: &[
+            (5.528, 0.0),
+            (4.780, 2.097),
+            (4.300, 4.021),
+            (4.033, 5.998),
+            (3.979, 8.094),
+            (3.881, 10.105),
+            (3.881, 12.150),
+            (3.748, 14.255),
+            (3.783, 16.300),
+            (3.774, 18.311),
+            (3.765, 20.365),
+            (3.810, 22.496),
+        ],
+    },
+    TaylorTest {
+        case: "taylor-4340-282",
+        metal: "4340 steel",
+        impact_velocity: 282.0,
+        length: 12.7e-3,
+        diameter: 7.62e-3,
+        references: &[experiment(0.843 * 12.7e-3, 10.4e-3)],
+        experiment_profile: &[],
+    },
+    TaylorTest {
+        case: "taylor-4340-343",
+        metal: "4340 steel",
+        impact_velocity: 343.0,
+        length: 8.1e-3,
+        diameter: 7.62e-3,
+        references: &[experiment(0.808 * 8.1e-3, 12.0e-3)],
+        experiment_profile: &[],
+    },
+    TaylorTest {
+        case: "taylor-42crmo4-287",
+        metal: "42CrMo4 steel",
+        impact_velocity: 287.0,
+        length: 32.4e-3,
+        diameter: 6.4e-3,
+        // DynELA documentation, Samples-Impacts.tex: axisymmetric runs
+        // (5 x 50 elements), values at the impact face's centre element.
+        references: &[
+            Reference {
+                source: "code (DynELA, axisymmetric)",
+                experiment: false,
+                final_length: Some(26.52e-3),
+                face_diameter: Some(11.15e-3),
+                peak_plastic_strain: Some(1.78),
+                peak_temperature: Some(582.34 + 273.15),
+            },
+            Reference {
+                source: "code (Abaqus, axisymmetric)",
+                experiment: false,
+                final_length: Some(26.56e-3),
+                face_diameter: Some(11.16e-3),
+                peak_plastic_strain: Some(1.81),
+                peak_temperature: Some(590.96 + 273.15),
+            },
+        ],
+        experiment_profile: &[],
+    },
+];
+
+/// The three particle spacings of the convergence study, m: `(name,
+/// spacing)`; "medium" is the case file's.
+pub const RESOLUTIONS: [(&str, Real); 3] = [("coarse", 0.4e-3), ("medium", 0.2e-3), ("fine", 0.1e-3)];
+
+/// The overrides that give test `t`'s bar particles of about `spacing`
+/// (m): rows along the bar so that the spacing divides its length, and the
+/// same spacing across.
+pub fn resolution_overrides(t: &TaylorTest, spacing: Real) -> Vec<String> {
+    let layers = (t.length / spacing).round() as usize + 1;
+    let h = t.length / (layers - 1) as Real;
+    vec![format!("bodies.bar.rectangle.layers={layers}"), format!("bodies.bar.rectangle.fine_spacing={h:e}")]
+}
+
+/// What [`measure`] finds in a Taylor bar (module doc).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Measurement {
+    /// m.
+    pub final_length: Real,
+    /// m.
+    pub face_diameter: Real,
+    /// Largest plastic strain over all points, over the first cell row,
+    /// and over the points at least two spacings from the face.
+    pub peak_plastic_strain: Real,
+    pub face_peak_plastic_strain: Real,
+    pub interior_peak_plastic_strain: Real,
+    /// K.
+    pub peak_temperature: Real,
+    /// Impact face then outer column, `(radius, height above the lowest
+    /// point)`, m.
+    pub profile: Vec<(Real, Real)>,
+}
+
+/// Measure the bar of a single-body axisymmetric model (module doc).
+pub fn measure(model: &Model) -> Measurement {
+    let p = &model.particles;
+    let x: Vec<Vec2> = (0..p.len()).map(|i| p.x0[i] + model.particle_shape.interpolate(i, &p.u)).collect();
+    let (y_lo, y_hi) = x.iter().fold((Real::MAX, Real::MIN), |(a, b), v| (a.min(v.y), b.max(v.y)));
+    let face_y = p.x0.iter().map(|v| v.y).fold(Real::MAX, Real::min);
+    let outer_x = p.x0.iter().map(|v| v.x).fold(Real::MIN, Real::max);
+    let h = p.spacing.iter().copied().fold(Real::MAX, Real::min);
+    let tol = 1e-9 * (1.0 + outer_x.abs());
+    let face: Vec<usize> = (0..p.len()).filter(|&i| (p.x0[i].y - face_y).abs() < tol).collect();
+    let face_radius = face.iter().map(|&i| x[i].x).fold(0.0, Real::max);
+    let q = &model.quad;
+    let max_where =
+        |keep: &dyn Fn(usize) -> bool| (0..q.len()).filter(|&k| keep(k)).map(|k| q.eps_p[k]).fold(0.0, Real::max);
+    let mut face_sorted = face.clone();
+    face_sorted.sort_by(|&a, &b| p.x0[a].x.total_cmp(&p.x0[b].x));
+    let mut column: Vec<usize> = (0..p.len()).filter(|&i| (p.x0[i].x - outer_x).abs() < tol).collect();
+    column.sort_by(|&a, &b| p.x0[a].y.total_cmp(&p.x0[b].y));
+    let profile = face_sorted.iter().chain(&column).map(|&i| (x[i].x, x[i].y - y_lo)).collect();
+    Measurement {
+        final_length: y_hi - y_lo,
+        face_diameter: 2.0 * face_radius,
+        peak_plastic_strain: max_where(&|_| true),
+        face_peak_plastic_strain: max_where(&|k| q.x0[k].y < face_y + h),
+        interior_peak_plastic_strain: max_where(&|k| q.x0[k].y >= face_y + 2.0 * h),
+        peak_temperature: q.temperature.iter().copied().fold(Real::MIN, Real::max),
+        profile,
+    }
+}
+
+/// One run of a Taylor test at one resolution.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    pub test: TaylorTest,
+    /// Resolution name and nominal spacing, m.
+    pub resolution: &'static str,
+    pub spacing: Real,
+    pub particles: usize,
+    pub steps: u64,
+    /// Wall time, s.
+    pub wall: Real,
+    /// The state at the end, or where the run stopped.
+    pub measurement: Option<Measurement>,
+    /// Why the run stopped early, with the time (s).
+    pub failure: Option<(Real, String)>,
+}
+
+/// Run `test` at `(resolution, spacing)` to its end time with the extra
+/// overrides `set` (applied after the resolution's), in memory (no output
+/// files), and measure the bar at the end or where it stopped.
+pub fn run_test(test: &TaylorTest, resolution: (&'static str, Real), set: &[String]) -> Outcome {
+    let t0 = Instant::now();
+    let mut overrides = resolution_overrides(test, resolution.1);
+    overrides.extend_from_slice(set);
+    let mut outcome = Outcome {
+        test: *test,
+        resolution: resolution.0,
+        spacing: resolution.1,
+        particles: 0,
+        steps: 0,
+        wall: 0.0,
+        measurement: None,
+        failure: None,
+    };
+    let text = builtin_case(test.case).expect("Taylor tests name built-in cases");
+    let sim = Case::from_str_with(text, test.case, &overrides)
+        .map_err(|e| e.to_string())
+        .and_then(|c| build_simulation(&c.resolved()).map(|s| (s, c.time.end)).map_err(|e| e.to_string()));
+    match sim {
+        Err(e) => outcome.failure = Some((0.0, e)),
+        Ok((mut sim, end)) => {
+            outcome.particles = sim.model.particles.len();
+            while sim.time < end * (1.0 - 1e-12) {
+                if let Err(e) = sim.step() {
+                    outcome.failure = Some((sim.time, e.to_string()));
+                    break;
+                }
+            }
+            outcome.steps = sim.step;
+            outcome.measurement = Some(measure(&sim.model));
+        }
+    }
+    outcome.wall = t0.elapsed().as_secs_f64();
+    outcome
+}
+
+fn pct(ours: Real, reference: Real) -> String {
+    format!("{:+.1}", 100.0 * (ours - reference) / reference)
+}
+
+/// The table as Markdown and CSV: per run, ours against each reference
+/// (length and diameter in mm, temperature in K, differences in %).
+pub fn table(outcomes: &[Outcome]) -> (String, String) {
+    let mut md = String::from(
+        "| case | resolution | particles | steps | wall (s) | status | L_f (mm) | D_face (mm) | peak ε̄p: all / face / interior | peak T (K) | reference | ref L_f (mm) | ΔL % | ref D (mm) | ΔD % | ref ε̄p | Δε̄p % | ref T (K) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    let mut csv = String::from(
+        "case,resolution,spacing_mm,particles,steps,wall_s,status,final_length_mm,face_diameter_mm,peak_plastic_strain,face_peak_plastic_strain,interior_peak_plastic_strain,peak_temperature_k,reference,ref_final_length_mm,ref_face_diameter_mm,ref_peak_plastic_strain,ref_peak_temperature_k\n",
+    );
+    let mm = |v: Option<Real>| v.map_or_else(|| "—".to_string(), |v| format!("{:.2}", v * 1e3));
+    let num = |v: Option<Real>, d: usize| v.map_or_else(String::new, |v| format!("{v:.d$}"));
+    for o in outcomes {
+        let status = match &o.failure {
+            None => "ok".to_string(),
+            Some((t, e)) => format!("stopped at {:.2} µs: {}", t * 1e6, e.split(';').next().unwrap_or("")),
+        };
+        let m = o.measurement.as_ref();
+        for r in o.test.references {
+            let d = |ours: Option<Real>, refv: Option<Real>| match (ours, refv) {
+                (Some(a), Some(b)) if o.failure.is_none() => pct(a, b),
+                _ => "—".to_string(),
+            };
+            let (lf, df) = (m.map(|m| m.final_length), m.map(|m| m.face_diameter));
+            let eps = m.map(|m| m.peak_plastic_strain);
+            md.push_str(&format!(
+                "| {} | {} ({} mm) | {} | {} | {:.0} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+                o.test.case,
+                o.resolution,
+                crate::io::short_number(o.spacing * 1e3),
+                o.particles,
+                o.steps,
+                o.wall,
+                status,
+                mm(lf),
+                mm(df),
+                m.map_or_else(
+                    || "—".into(),
+                    |m| format!(
+                        "{:.2} / {:.2} / {:.2}",
+                        m.peak_plastic_strain, m.face_peak_plastic_strain, m.interior_peak_plastic_strain
+                    )
+                ),
+                m.map_or_else(|| "—".into(), |m| format!("{:.0}", m.peak_temperature)),
+                r.source,
+                mm(r.final_length),
+                d(lf, r.final_length),
+                mm(r.face_diameter),
+                d(df, r.face_diameter),
+                r.peak_plastic_strain.map_or_else(|| "—".into(), |v| format!("{v:.2}")),
+                d(eps, r.peak_plastic_strain),
+                r.peak_temperature.map_or_else(|| "—".into(), |v| format!("{v:.0}")),
+            ));
+            csv.push_str(&format!(
+                "{},{},{},{},{},{:.1},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+                o.test.case,
+                o.resolution,
+                o.spacing * 1e3,
+                o.particles,
+                o.steps,
+                o.wall,
+                status.replace(',', ";"),
+                num(lf.map(|v| v * 1e3), 4),
+                num(df.map(|v| v * 1e3), 4),
+                num(eps, 4),
+                num(m.map(|m| m.face_peak_plastic_strain), 4),
+                num(m.map(|m| m.interior_peak_plastic_strain), 4),
+                num(m.map(|m| m.peak_temperature), 1),
+                r.source,
+                num(r.final_length.map(|v| v * 1e3), 4),
+                num(r.face_diameter.map(|v| v * 1e3), 4),
+                num(r.peak_plastic_strain, 3),
+                num(r.peak_temperature, 1),
+            ));
+        }
+    }
+    (md, csv)
+}
+
+/// The deformed outlines of `test`'s runs (radius against height, mm), with
+/// the digitised experiment's where there is one.
+pub fn profile_plot(outcomes: &[Outcome], test: &TaylorTest) -> LinePlot {
+    let mut series: Vec<Series> = outcomes
+        .iter()
+        .filter(|o| o.test.case == test.case)
+        .filter_map(|o| {
+            let m = o.measurement.as_ref()?;
+            let stopped = if o.failure.is_some() { " (stopped early)" } else { "" };
+            Some(Series {
+                name: format!("plugsim {} mm{stopped}", crate::io::short_number(o.spacing * 1e3)),
+                points: m.profile.iter().map(|&(r, z)| (r * 1e3, z * 1e3)).collect(),
+            })
+        })
+        .collect();
+    if !test.experiment_profile.is_empty() {
+        series
+            .push(Series { name: "experiment (Johnson & Cook 1983)".into(), points: test.experiment_profile.to_vec() });
+    }
+    LinePlot {
+        title: format!("{}: {} m/s", test.metal, crate::io::short_number(test.impact_velocity)),
+        x_label: "radius (mm)".into(),
+        y_label: "height above the impact face (mm)".into(),
+        series,
+        hlines: Vec::new(),
+    }
+}
+
+/// How the columns are measured (printed under the table).
+pub const METHODS: &str = "L_f: the bar's length at the end (80 µs), from the physical particle \
+positions. D_face: twice the largest radius of the impact face's particles. Peak ε̄p: the largest \
+plastic strain over the quadrature points; over the first cell row (face); and over the points at \
+least two spacings from the face (interior). Peak T: the largest temperature. Δ: ours against the \
+reference, %, for runs that reached the end. The resolution is the particle spacing along and \
+across the bar; medium is the case file's.";
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cases::BUILTIN_CASES;
+
+    #[test]
+    fn every_test_is_a_built_in_case_of_its_bar() {
+        for t in TAYLOR_TESTS {
+            let case = Case::from_str_with(builtin_case(t.case).unwrap(), t.case, &[]).unwrap();
+            let r = &case.bodies[0].rectangle;
+            assert!((r.y_max - r.y_min - t.length).abs() < 1e-12, "{}", t.case);
+            assert!((2.0 * (r.x_max - r.x_min) - t.diameter).abs() < 1e-12, "{}", t.case);
+            assert_eq!(case.bodies[0].initial_velocity[0].velocity[1], -t.impact_velocity, "{}", t.case);
+            assert!(case.rigid_bodies[0].prescribed, "{}", t.case);
+            assert!(!t.references.is_empty());
+        }
+        let listed = BUILTIN_CASES.iter().filter(|c| c.0.starts_with("taylor-")).count();
+        assert_eq!(listed, TAYLOR_TESTS.len());
+    }
+
+    #[test]
+    fn resolution_overrides_divide_the_length() {
+        let t = &TAYLOR_TESTS[5]; // 8.1 mm bar
+        let o = resolution_overrides(t, 0.4e-3);
+        assert_eq!(o[0], "bodies.bar.rectangle.layers=21");
+        let h: Real = o[1].split('=').nth(1).unwrap().parse().unwrap();
+        assert!((h * 20.0 - 8.1e-3).abs() < 1e-15);
+    }
+}
