@@ -164,6 +164,11 @@ pub const BUILTIN_CASES: &[(&str, &str, &str)] = &[
         "Taylor anvil test: OFHC copper, 190 m/s, axisymmetric, rigid wall",
     ),
     (
+        "taylor-cu-190-rod-on-rod",
+        include_str!("../cases/taylor-cu-190-rod-on-rod.toml"),
+        "Rod on rod: two OFHC copper bars head on, 190 m/s each (= taylor-cu-190 onto its anvil), axisymmetric",
+    ),
+    (
         "taylor-4340-208",
         include_str!("../cases/taylor-4340-208.toml"),
         "Taylor anvil test: 4340 steel, 208 m/s, L0 = 25.4 mm, axisymmetric, rigid wall",

@@ -414,8 +414,13 @@ fn validate(out: &Path, all: bool, only: Option<&str>, full_time: bool) -> Resul
 /// `plugsim validate --family taylor`: the Taylor anvil tests at two (three
 /// with `--all`) resolutions, table, CSV and profile plots into `out`.
 fn validate_taylor(out: &Path, all: bool, only: Option<&str>, set: &[String]) -> Result<()> {
-    use plugsim::taylor::{profile_plot, run_test, table, METHODS, RESOLUTIONS, TAYLOR_TESTS};
-    let tests: Vec<_> = TAYLOR_TESTS.iter().filter(|t| only.is_none_or(|o| t.case.contains(o))).collect();
+    use plugsim::taylor::{profile_plot, run_test, symmetry_table, table, METHODS, RESOLUTIONS, TAYLOR_TESTS};
+    let picked = |case: &str| only.is_none_or(|o| case.contains(o));
+    // A rod-on-rod case brings its anvil twin, which it is compared with.
+    let tests: Vec<_> = TAYLOR_TESTS
+        .iter()
+        .filter(|t| picked(t.case) || TAYLOR_TESTS.iter().any(|r| picked(r.case) && r.anvil_twin == Some(t.case)))
+        .collect();
     if tests.is_empty() {
         bail!("no Taylor test matches {only:?} (see `plugsim cases`, the taylor-* names)");
     }
@@ -451,7 +456,13 @@ fn validate_taylor(out: &Path, all: bool, only: Option<&str>, set: &[String]) ->
         rayon::current_num_threads(),
         if set.is_empty() { "none (the case files' settings)".to_string() } else { set.join(" ") }
     );
-    let report = format!("{header}\n\n{md}\n{METHODS}\n\n{plots}");
+    let symmetry = symmetry_table(&outcomes);
+    let symmetry = if symmetry.lines().count() > 2 {
+        format!("Rod on rod against rod on anvil (the symmetric impact must reproduce the anvil):\n\n{symmetry}\n")
+    } else {
+        String::new()
+    };
+    let report = format!("{header}\n\n{md}\n{symmetry}{METHODS}\n\n{plots}");
     std::fs::write(out.join("taylor.md"), &report)?;
     std::fs::write(out.join("taylor.csv"), &csv)?;
     println!("{report}");

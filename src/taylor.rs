@@ -19,6 +19,11 @@
 //!   against height above the lowest point (the deformed outline the
 //!   experiments digitised).
 //!
+//! The bar is body 0 of its case (`bar`). In the rod-on-rod case a second
+//! body, `mirror`, flies into it: [`TaylorTest::anvil_twin`] names the anvil
+//! case it must reproduce, and the report gives the two side by side
+//! ([`symmetry_table`]).
+//!
 //! Resolutions: [`RESOLUTIONS`] gives each case three particle spacings
 //! (0.4, 0.2 = the case file, 0.1 mm) by overriding the bar's `layers` and
 //! `fine_spacing`, nothing else.
@@ -64,6 +69,9 @@ pub struct TaylorTest {
     /// A digitised deformed outline of the recovered bar, `(radius, height)`
     /// in mm (none if not found).
     pub experiment_profile: &'static [(Real, Real)],
+    /// For a rod-on-rod case (its bar hit by a mirror image, body
+    /// `mirror`): the anvil case whose bar it must reproduce.
+    pub anvil_twin: Option<&'static str>,
 }
 
 /// Johnson & Cook (1983) as tabulated in `bbanerjee/HighRateExptData`
@@ -81,6 +89,22 @@ const fn experiment(final_length: Real, face_diameter: Real) -> Reference {
         peak_temperature: None,
     }
 }
+
+/// The references of copper at 190 m/s (the anvil and the rod-on-rod cases).
+const CU_190: &[Reference] = &[
+    experiment(0.638 * 25.4e-3, 1.78 * 7.62e-3),
+    // molanocortes/OpenPhysicsAI docs/lab/impact.md: its hexahedral
+    // solver with the same Johnson-Cook set, L/L0 = 0.685, D/D0 =
+    // 1.91 (an unreviewed public code; no strain or temperature).
+    Reference {
+        source: "code (OpenPhysicsAI, hexahedra)",
+        experiment: false,
+        final_length: Some(0.685 * 25.4e-3),
+        face_diameter: Some(1.91 * 7.62e-3),
+        peak_plastic_strain: None,
+        peak_temperature: None,
+    },
+];
 
 /// The Taylor tests and their references (sources in each case file's
 /// header and in docs/validation.md). Lengths from ratios: copper
@@ -108,6 +132,7 @@ pub const TAYLOR_TESTS: &[TaylorTest] = &[
             (3.8186, 17.755),
             (3.8100, 19.649),
         ],
+        anvil_twin: None,
     },
     TaylorTest {
         case: "taylor-cu-146",
@@ -117,6 +142,7 @@ pub const TAYLOR_TESTS: &[TaylorTest] = &[
         diameter: 7.62e-3,
         references: &[experiment(0.736 * 25.4e-3, 1.40 * 7.62e-3)],
         experiment_profile: &[],
+        anvil_twin: None,
     },
     TaylorTest {
         case: "taylor-cu-190",
@@ -124,21 +150,19 @@ pub const TAYLOR_TESTS: &[TaylorTest] = &[
         impact_velocity: 190.0,
         length: 25.4e-3,
         diameter: 7.62e-3,
-        references: &[
-            experiment(0.638 * 25.4e-3, 1.78 * 7.62e-3),
-            // molanocortes/OpenPhysicsAI docs/lab/impact.md: its hexahedral
-            // solver with the same Johnson-Cook set, L/L0 = 0.685, D/D0 =
-            // 1.91 (an unreviewed public code; no strain or temperature).
-            Reference {
-                source: "code (OpenPhysicsAI, hexahedra)",
-                experiment: false,
-                final_length: Some(0.685 * 25.4e-3),
-                face_diameter: Some(1.91 * 7.62e-3),
-                peak_plastic_strain: None,
-                peak_temperature: None,
-            },
-        ],
+        references: CU_190,
         experiment_profile: &[],
+        anvil_twin: None,
+    },
+    TaylorTest {
+        case: "taylor-cu-190-rod-on-rod",
+        metal: "OFHC copper",
+        impact_velocity: 190.0,
+        length: 25.4e-3,
+        diameter: 7.62e-3,
+        references: CU_190,
+        experiment_profile: &[],
+        anvil_twin: Some("taylor-cu-190"),
     },
     TaylorTest {
         case: "taylor-4340-208",
@@ -162,6 +186,7 @@ pub const TAYLOR_TESTS: &[TaylorTest] = &[
             (3.765, 20.365),
             (3.810, 22.496),
         ],
+        anvil_twin: None,
     },
     TaylorTest {
         case: "taylor-4340-282",
@@ -171,6 +196,7 @@ pub const TAYLOR_TESTS: &[TaylorTest] = &[
         diameter: 7.62e-3,
         references: &[experiment(0.843 * 12.7e-3, 10.4e-3)],
         experiment_profile: &[],
+        anvil_twin: None,
     },
     TaylorTest {
         case: "taylor-4340-343",
@@ -180,6 +206,7 @@ pub const TAYLOR_TESTS: &[TaylorTest] = &[
         diameter: 7.62e-3,
         references: &[experiment(0.808 * 8.1e-3, 12.0e-3)],
         experiment_profile: &[],
+        anvil_twin: None,
     },
     TaylorTest {
         case: "taylor-42crmo4-287",
@@ -208,6 +235,7 @@ pub const TAYLOR_TESTS: &[TaylorTest] = &[
             },
         ],
         experiment_profile: &[],
+        anvil_twin: None,
     },
 ];
 
@@ -221,7 +249,13 @@ pub const RESOLUTIONS: [(&str, Real); 3] = [("coarse", 0.4e-3), ("medium", 0.2e-
 pub fn resolution_overrides(t: &TaylorTest, spacing: Real) -> Vec<String> {
     let layers = (t.length / spacing).round() as usize + 1;
     let h = t.length / (layers - 1) as Real;
-    vec![format!("bodies.bar.rectangle.layers={layers}"), format!("bodies.bar.rectangle.fine_spacing={h:e}")]
+    let bodies: &[&str] = if t.anvil_twin.is_some() { &["bar", "mirror"] } else { &["bar"] };
+    bodies
+        .iter()
+        .flat_map(|b| {
+            [format!("bodies.{b}.rectangle.layers={layers}"), format!("bodies.{b}.rectangle.fine_spacing={h:e}")]
+        })
+        .collect()
 }
 
 /// What [`measure`] finds in a Taylor bar (module doc).
@@ -243,23 +277,25 @@ pub struct Measurement {
     pub profile: Vec<(Real, Real)>,
 }
 
-/// Measure the bar of a single-body axisymmetric model (module doc).
+/// Measure the bar, body 0, of an axisymmetric model (module doc).
 pub fn measure(model: &Model) -> Measurement {
     let p = &model.particles;
+    let bar: Vec<usize> = (0..p.len()).filter(|&i| p.body[i] == 0).collect();
     let x: Vec<Vec2> = (0..p.len()).map(|i| p.x0[i] + model.particle_shape.interpolate(i, &p.u)).collect();
-    let (y_lo, y_hi) = x.iter().fold((Real::MAX, Real::MIN), |(a, b), v| (a.min(v.y), b.max(v.y)));
-    let face_y = p.x0.iter().map(|v| v.y).fold(Real::MAX, Real::min);
-    let outer_x = p.x0.iter().map(|v| v.x).fold(Real::MIN, Real::max);
-    let h = p.spacing.iter().copied().fold(Real::MAX, Real::min);
+    let (y_lo, y_hi) = bar.iter().fold((Real::MAX, Real::MIN), |(a, b), &i| (a.min(x[i].y), b.max(x[i].y)));
+    let face_y = bar.iter().map(|&i| p.x0[i].y).fold(Real::MAX, Real::min);
+    let outer_x = bar.iter().map(|&i| p.x0[i].x).fold(Real::MIN, Real::max);
+    let h = bar.iter().map(|&i| p.spacing[i]).fold(Real::MAX, Real::min);
     let tol = 1e-9 * (1.0 + outer_x.abs());
-    let face: Vec<usize> = (0..p.len()).filter(|&i| (p.x0[i].y - face_y).abs() < tol).collect();
+    let face: Vec<usize> = bar.iter().copied().filter(|&i| (p.x0[i].y - face_y).abs() < tol).collect();
     let face_radius = face.iter().map(|&i| x[i].x).fold(0.0, Real::max);
     let q = &model.quad;
-    let max_where =
-        |keep: &dyn Fn(usize) -> bool| (0..q.len()).filter(|&k| keep(k)).map(|k| q.eps_p[k]).fold(0.0, Real::max);
+    let max_where = |keep: &dyn Fn(usize) -> bool| {
+        (0..q.len()).filter(|&k| q.body[k] == 0 && keep(k)).map(|k| q.eps_p[k]).fold(0.0, Real::max)
+    };
     let mut face_sorted = face.clone();
     face_sorted.sort_by(|&a, &b| p.x0[a].x.total_cmp(&p.x0[b].x));
-    let mut column: Vec<usize> = (0..p.len()).filter(|&i| (p.x0[i].x - outer_x).abs() < tol).collect();
+    let mut column: Vec<usize> = bar.iter().copied().filter(|&i| (p.x0[i].x - outer_x).abs() < tol).collect();
     column.sort_by(|&a, &b| p.x0[a].y.total_cmp(&p.x0[b].y));
     let profile = face_sorted.iter().chain(&column).map(|&i| (x[i].x, x[i].y - y_lo)).collect();
     Measurement {
@@ -268,7 +304,7 @@ pub fn measure(model: &Model) -> Measurement {
         peak_plastic_strain: max_where(&|_| true),
         face_peak_plastic_strain: max_where(&|k| q.x0[k].y < face_y + h),
         interior_peak_plastic_strain: max_where(&|k| q.x0[k].y >= face_y + 2.0 * h),
-        peak_temperature: q.temperature.iter().copied().fold(Real::MIN, Real::max),
+        peak_temperature: (0..q.len()).filter(|&k| q.body[k] == 0).map(|k| q.temperature[k]).fold(Real::MIN, Real::max),
         profile,
     }
 }
@@ -331,6 +367,11 @@ pub fn run_test(test: &TaylorTest, resolution: (&'static str, Real), set: &[Stri
 
 fn pct(ours: Real, reference: Real) -> String {
     format!("{:+.1}", 100.0 * (ours - reference) / reference)
+}
+
+/// [`pct`] to a thousandth of a per cent (the rod-on-rod differences).
+fn fine_pct(ours: Real, reference: Real) -> String {
+    format!("{:+.3}", 100.0 * (ours - reference) / reference)
 }
 
 /// The table as Markdown and CSV: per run, ours against each reference
@@ -411,6 +452,34 @@ pub fn table(outcomes: &[Outcome]) -> (String, String) {
     (md, csv)
 }
 
+/// Each rod-on-rod run beside its anvil twin's at the same resolution, as
+/// Markdown: final length and face diameter and their differences (the
+/// symmetric impact must reproduce the anvil, issue #20: within 1 % in
+/// length).
+pub fn symmetry_table(outcomes: &[Outcome]) -> String {
+    let mut md = String::from(
+        "| rod-on-rod case | resolution | L_f rod on rod (mm) | L_f anvil (mm) | ΔL % | D_face rod on rod (mm) | D_face anvil (mm) | ΔD % |\n|---|---|---|---|---|---|---|---|\n",
+    );
+    for rod in outcomes.iter().filter(|o| o.test.anvil_twin.is_some()) {
+        let twin = outcomes.iter().find(|o| Some(o.test.case) == rod.test.anvil_twin && o.resolution == rod.resolution);
+        let (Some(a), Some(b)) = (rod.measurement.as_ref(), twin.and_then(|t| t.measurement.as_ref())) else {
+            continue;
+        };
+        md.push_str(&format!(
+            "| {} | {} | {:.3} | {:.3} | {} | {:.3} | {:.3} | {} |\n",
+            rod.test.case,
+            rod.resolution,
+            a.final_length * 1e3,
+            b.final_length * 1e3,
+            fine_pct(a.final_length, b.final_length),
+            a.face_diameter * 1e3,
+            b.face_diameter * 1e3,
+            fine_pct(a.face_diameter, b.face_diameter),
+        ));
+    }
+    md
+}
+
 /// The deformed outlines of `test`'s runs (radius against height, mm), with
 /// the digitised experiment's where there is one.
 pub fn profile_plot(outcomes: &[Outcome], test: &TaylorTest) -> LinePlot {
@@ -460,7 +529,22 @@ mod tests {
             assert!((r.y_max - r.y_min - t.length).abs() < 1e-12, "{}", t.case);
             assert!((2.0 * (r.x_max - r.x_min) - t.diameter).abs() < 1e-12, "{}", t.case);
             assert_eq!(case.bodies[0].initial_velocity[0].velocity[1], -t.impact_velocity, "{}", t.case);
-            assert!(case.rigid_bodies[0].prescribed, "{}", t.case);
+            match t.anvil_twin {
+                None => assert!(case.rigid_bodies[0].prescribed, "{}", t.case),
+                Some(twin) => {
+                    // The mirror image: the same bar below y = 0, flying up.
+                    let m = &case.bodies[1];
+                    assert_eq!((case.bodies[1].name.as_str(), case.rigid_bodies.len()), ("mirror", 0));
+                    assert_eq!((m.rectangle.y_min, m.rectangle.y_max), (-r.y_max, -r.y_min));
+                    assert_eq!((m.rectangle.x_max, m.rectangle.layers), (r.x_max, r.layers));
+                    assert_eq!(m.initial_velocity[0].velocity[1], t.impact_velocity);
+                    let anvil = TAYLOR_TESTS.iter().find(|a| a.case == twin).unwrap();
+                    assert_eq!(
+                        (anvil.impact_velocity, anvil.length, anvil.diameter),
+                        (t.impact_velocity, t.length, t.diameter)
+                    );
+                }
+            }
             assert!(!t.references.is_empty());
         }
         let listed = BUILTIN_CASES.iter().filter(|c| c.0.starts_with("taylor-")).count();
@@ -469,10 +553,17 @@ mod tests {
 
     #[test]
     fn resolution_overrides_divide_the_length() {
-        let t = &TAYLOR_TESTS[5]; // 8.1 mm bar
+        let t = TAYLOR_TESTS.iter().find(|t| t.case == "taylor-4340-343").unwrap(); // 8.1 mm bar
         let o = resolution_overrides(t, 0.4e-3);
+        assert_eq!(o.len(), 2);
         assert_eq!(o[0], "bodies.bar.rectangle.layers=21");
         let h: Real = o[1].split('=').nth(1).unwrap().parse().unwrap();
         assert!((h * 20.0 - 8.1e-3).abs() < 1e-15);
+        // The rod-on-rod case refines its mirror bar alike.
+        let rod = TAYLOR_TESTS.iter().find(|t| t.anvil_twin.is_some()).unwrap();
+        let o = resolution_overrides(rod, 0.4e-3);
+        assert_eq!(o.len(), 4);
+        assert_eq!(o[2], o[0].replace("bar", "mirror"));
+        assert_eq!(o[3], o[1].replace("bar", "mirror"));
     }
 }

@@ -82,3 +82,24 @@ fn every_taylor_case_runs_shortened() {
         assert!(m.face_peak_plastic_strain > 0.0 && m.peak_temperature > 295.0, "{}: {m:?}", t.case);
     }
 }
+
+/// In the rod-on-rod case the measured bar is body 0 alone: its mirror
+/// image (stretched otherwise here) enters neither length nor peaks.
+#[test]
+fn measure_reads_the_bar_of_the_rod_on_rod_case_alone() {
+    let t = TAYLOR_TESTS.iter().find(|t| t.anvil_twin.is_some()).unwrap();
+    let set = resolution_overrides(t, 0.4e-3);
+    let case = Case::from_str_with(builtin_case(t.case).unwrap(), t.case, &set).unwrap().resolved();
+    let mut sim = build_simulation(&case).unwrap();
+    let p = &mut sim.model.particles;
+    for i in 0..p.len() {
+        let s = if p.body[i] == 0 { -0.1 } else { 0.5 };
+        p.u[i] = Vec2::new(0.0, s * p.x0[i].y);
+    }
+    let q = &mut sim.model.quad;
+    let mirror = (0..q.len()).find(|&k| q.body[k] == 1).unwrap();
+    q.eps_p[mirror] = 9.0;
+    let m = measure(&sim.model);
+    assert!((m.final_length - 0.9 * t.length).abs() < 1e-9 * t.length, "{}", m.final_length);
+    assert!(m.peak_plastic_strain < 9.0);
+}
