@@ -536,10 +536,15 @@ fn borvik_plane_strain_case_file_is_valid() {
     assert_eq!(case.fracture.criterion, Criterion::EffectiveStrain);
     assert_eq!(case.fracture.critical_effective_strain, 0.30);
     assert!(case.time.end >= 60e-6);
-    // no [fracture] section: no cracks
+    // "none": no cracks
     let plain = include_str!("../cases/borvik-1-nofracture.toml");
     let case = Case::from_str_with(plain, "nofracture", &[]).unwrap();
     assert_eq!(case.fracture.criterion, Criterion::None);
+    // no [fracture] section: the default model
+    let bare = plain.replace("[fracture]\ncriterion = \"none\"", "");
+    let case = Case::from_str_with(&bare, "bare", &[]).unwrap();
+    assert_eq!(case.fracture, plugsim::fracture::FractureParameters::default());
+    assert_eq!(case.fracture.criterion, Criterion::NonlocalDamage);
 }
 
 /// Bad `[fracture]` values are all reported, each with its key.
@@ -578,7 +583,7 @@ fn fracture_section_is_validated() {
     let ok = ["fracture.criterion=\"nonlocal_damage\"".to_string(), "fracture.band_width=0.2e-3".to_string()];
     let case = Case::from_str_with(text, "f.toml", &ok).unwrap();
     assert_eq!(case.fracture.criterion, Criterion::NonlocalDamage);
-    assert_eq!(case.fracture.band_width, Some(0.2e-3));
+    assert_eq!(case.fracture.band_width, 0.2e-3);
 }
 
 /// `time.stop_after_release`: a run that perforates ends once the
