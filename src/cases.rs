@@ -134,6 +134,26 @@ pub const BUILTIN_CASES: &[(&str, &str, &str)] = &[
         "Borvik Case II (173.7 m/s, 10.2 mm), axisymmetric, fine, damage cracks, Borvik's modified material",
     ),
     (
+        "borvik-1-axisymmetric-nonlocal",
+        include_str!("../cases/borvik-1-axisymmetric-nonlocal.toml"),
+        "Borvik Case I (298 m/s, 11.1 mm), axisymmetric, coarse, the default fracture model (damage over a length)",
+    ),
+    (
+        "borvik-1-axisymmetric-fine-nonlocal",
+        include_str!("../cases/borvik-1-axisymmetric-fine-nonlocal.toml"),
+        "Borvik Case I (298 m/s, 11.1 mm), axisymmetric, fine, the default fracture model (damage over a length)",
+    ),
+    (
+        "borvik-2-axisymmetric-nonlocal",
+        include_str!("../cases/borvik-2-axisymmetric-nonlocal.toml"),
+        "Borvik Case II (173.7 m/s, 10.2 mm), axisymmetric, coarse, the default fracture model (damage over a length)",
+    ),
+    (
+        "borvik-2-axisymmetric-fine-nonlocal",
+        include_str!("../cases/borvik-2-axisymmetric-fine-nonlocal.toml"),
+        "Borvik Case II (173.7 m/s, 10.2 mm), axisymmetric, fine, the default fracture model (damage over a length)",
+    ),
+    (
         "borvik-2002-12mm-blunt",
         include_str!("../cases/borvik-2002-12mm-blunt.toml"),
         "Borvik et al. 2002 nose shapes: blunt nose, 12 mm Weldox 460 E, 300 m/s (not a test speed), axisymmetric, coarse",
@@ -221,7 +241,9 @@ pub struct BorvikCase {
     pub geometry: &'static str,
     /// `"coarse"` (24 rows) or `"fine"` (48 rows).
     pub discretization: &'static str,
-    /// `"effective_strain"` or `"damage"`.
+    /// `"effective_strain"` or `"damage"` ([RL10]'s, the paper's mode), or
+    /// `"nonlocal_damage"` (the default model, axisymmetric with [RL10]'s
+    /// material only).
     pub criterion: &'static str,
     /// The built-in material: [`MATERIAL_RL10`] or [`MATERIAL_MODIFIED`].
     pub material: &'static str,
@@ -229,7 +251,7 @@ pub struct BorvikCase {
 
 impl BorvikCase {
     /// The built-in case's name,
-    /// `borvik-<1|2>-<plane-strain|axisymmetric>[-fine][-damage][-modified]`.
+    /// `borvik-<1|2>-<plane-strain|axisymmetric>[-fine][-damage|-nonlocal][-modified]`.
     pub fn name(&self) -> String {
         let mut n = format!("borvik-{}-{}", self.experiment, self.geometry.replace('_', "-"));
         if self.discretization == "fine" {
@@ -237,6 +259,9 @@ impl BorvikCase {
         }
         if self.criterion == "damage" {
             n.push_str("-damage");
+        }
+        if self.criterion == "nonlocal_damage" {
+            n.push_str("-nonlocal");
         }
         if self.material == MATERIAL_MODIFIED {
             n.push_str("-modified");
@@ -262,9 +287,10 @@ impl BorvikCase {
 }
 
 /// The whole reference family, in the order `plugsim validate` reports it:
-/// per case, both geometries × both discretizations × both criteria with
-/// \[RL10\]'s material, then the axisymmetric fine cases with Børvik's
-/// modified material (both criteria): 20 cases.
+/// per case, both geometries × both discretizations × both of \[RL10\]'s
+/// criteria with its material, the axisymmetric fine cases with Børvik's
+/// modified material (both criteria), then the axisymmetric cases with the
+/// default fracture model (coarse and fine): 24 cases.
 pub fn borvik_family() -> Vec<BorvikCase> {
     let mut v = Vec::new();
     for experiment in [1, 2] {
@@ -282,6 +308,15 @@ pub fn borvik_family() -> Vec<BorvikCase> {
                 discretization: "fine",
                 criterion,
                 material: MATERIAL_MODIFIED,
+            });
+        }
+        for discretization in ["coarse", "fine"] {
+            v.push(BorvikCase {
+                experiment,
+                geometry: "axisymmetric",
+                discretization,
+                criterion: "nonlocal_damage",
+                material: MATERIAL_RL10,
             });
         }
     }
@@ -306,7 +341,7 @@ mod tests {
     #[test]
     fn every_family_member_and_alias_is_built_in() {
         let family = borvik_family();
-        assert_eq!(family.len(), 20);
+        assert_eq!(family.len(), 24);
         for m in &family {
             assert!(builtin_case(&m.name()).is_some(), "{} is not built in", m.name());
         }
@@ -315,6 +350,8 @@ mod tests {
             assert!(builtin_case(name).is_some());
         }
         assert_eq!(family[0].name(), "borvik-1-plane-strain");
-        assert_eq!(family[19].name(), "borvik-2-axisymmetric-fine-damage-modified");
+        assert_eq!(family[9].name(), "borvik-1-axisymmetric-fine-damage-modified");
+        assert_eq!(family[11].name(), "borvik-1-axisymmetric-fine-nonlocal");
+        assert_eq!(family[23].name(), "borvik-2-axisymmetric-fine-nonlocal");
     }
 }

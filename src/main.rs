@@ -75,7 +75,10 @@ enum Command {
         /// of stopping 20 us after the projectile's release.
         #[arg(long)]
         full_time: bool,
-        /// Which family: borvik (the plugging cases) or taylor (the Taylor
+        /// Which family: borvik (the plugging cases), convergence (the
+        /// axisymmetric Borvik cases at 12, 24 and 48 rows through the
+        /// thickness, for the default fracture model and [RL10]'s criteria;
+        /// --only selects among the coarse rows' names) or taylor (the Taylor
         /// anvil tests, taylor-*: coarse and medium resolutions, fine with --all;
         /// --only selects among their case names).
         #[arg(long, default_value = "borvik")]
@@ -264,7 +267,9 @@ fn dispatch(cmd: Command) -> Result<()> {
             "borvik" if set.is_empty() => validate(&out, all, only.as_deref(), full_time),
             "borvik" => bail!("--set applies to the taylor family only"),
             "taylor" => validate_taylor(&out, all, only.as_deref(), &set),
-            other => bail!("unknown validation family `{other}` (borvik or taylor)"),
+            "convergence" if set.is_empty() => validate_convergence(&out, only.as_deref()),
+            "convergence" => bail!("--set applies to the taylor family only"),
+            other => bail!("unknown validation family `{other}` (borvik, convergence or taylor)"),
         },
         Command::MaterialPoint { material, case_file, path, rate, strain, dt, out } => {
             material_point(&material, case_file.as_deref(), path, rate, strain, dt, &out)
@@ -408,6 +413,58 @@ fn validate(out: &Path, all: bool, only: Option<&str>, full_time: bool) -> Resul
     std::fs::write(out.join("validation.csv"), &csv)?;
     println!("{md}");
     println!("written: {0}/validation.md, {0}/validation.csv and the plots beside them", out.display());
+    Ok(())
+}
+
+/// `plugsim validate --family convergence`: each axisymmetric Børvik row
+/// with [RL10]'s material at the three resolutions of the ladder, the
+/// convergence table (Markdown, CSV) into `out`.
+fn validate_convergence(out: &Path, only: Option<&str>) -> Result<()> {
+    use plugsim::validation::{convergence_rows, convergence_table, run_row_with, rung, select, LADDER, METHODS};
+    let rows = match only {
+        Some(o) => select(convergence_rows(), o),
+        None => convergence_rows(),
+    };
+    if rows.is_empty() {
+        bail!("no convergence row matches {only:?} (the coarse axisymmetric borvik-* names)");
+    }
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    let total = rows.len() * LADDER.len();
+    eprintln!("plugsim validate --family convergence: {total} runs into {}", out.display());
+    let mut ladders = Vec::new();
+    for row in rows {
+        let mut outcomes = Vec::new();
+        for layers in LADDER {
+            let (r, set) = rung(&row, layers);
+            let dir = out.join(format!("{}-{layers}rows", row.id));
+            eprintln!(
+                "  [{}/{total}] {} at {layers} rows ...",
+                ladders.len() * LADDER.len() + outcomes.len() + 1,
+                row.id
+            );
+            let o = run_row_with(&r, &dir, false, &set);
+            eprintln!(
+                "        {:.1} s{}",
+                o.wall,
+                o.result.as_ref().err().map(|e| format!(", failed: {e}")).unwrap_or_default()
+            );
+            outcomes.push(o);
+        }
+        ladders.push((row, outcomes));
+    }
+    let (md, csv) = convergence_table(&ladders);
+    let header = format!(
+        "Produced by `plugsim validate --family convergence` ({} {}) on {}, {} threads: each row at 12, 24 and 48 particle rows through the thickness (the coarse case with `layers = 12` and its coarsest spacing doubled, the coarse case, the fine case); spread = (max - min) / mean of the three residual velocities.",
+        env!("CARGO_PKG_VERSION"),
+        env!("PLUGSIM_COMMIT"),
+        cpu_name(),
+        rayon::current_num_threads()
+    );
+    let report = format!("{header}\n\n{md}\n{METHODS}\n");
+    std::fs::write(out.join("convergence.md"), &report)?;
+    std::fs::write(out.join("convergence.csv"), &csv)?;
+    println!("{report}");
+    println!("written: {0}/convergence.md, {0}/convergence.csv", out.display());
     Ok(())
 }
 

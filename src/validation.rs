@@ -123,13 +123,14 @@ impl Row {
     }
 }
 
-/// Every row: the whole family, in its order (20 rows).
+/// Every row: the whole family, in its order (24 rows).
 pub fn all_rows() -> Vec<Row> {
     borvik_family().into_iter().map(Row::of).collect()
 }
 
 /// The coarse rows (what `plugsim validate` runs by default): both cases,
-/// both geometries, both criteria (8 rows).
+/// both geometries, both of \[RL10\]'s criteria, and the default model in
+/// axisymmetry (10 rows).
 pub fn coarse_rows() -> Vec<Row> {
     all_rows().into_iter().filter(|r| r.case.discretization == "coarse").collect()
 }
@@ -222,11 +223,18 @@ pub const RELEASE_WAIT: Real = 20.0e-6;
 /// Run one row into `out/ROW_ID`, to the case's end time if `full_time`,
 /// else until [`RELEASE_WAIT`] after the projectile's release.
 pub fn run_row(row: &Row, out: &Path, full_time: bool) -> Outcome {
-    let dir = out.join(&row.id);
+    run_row_with(row, &out.join(&row.id), full_time, &[])
+}
+
+/// [`run_row`] into `dir`, with the overrides `extra` applied to the
+/// row's case after the stop rule.
+pub fn run_row_with(row: &Row, dir: &Path, full_time: bool, extra: &[String]) -> Outcome {
+    let dir = dir.to_path_buf();
     let t = std::time::Instant::now();
     let text = builtin_case(&row.id).expect("validation rows name built-in cases");
-    let set: Vec<String> =
+    let mut set: Vec<String> =
         if full_time { Vec::new() } else { vec![format!("time.stop_after_release={RELEASE_WAIT:e}")] };
+    set.extend_from_slice(extra);
     let result = Case::from_str_with(text, &row.id, &set).map_err(|e| e.to_string()).and_then(|case| {
         let cfg = RunConfig::new(dir.clone(), true, RunInfo::current(&row.id, &set));
         execute(&case, &cfg, &mut |_| {}).map_err(|e: RunError| e.to_string())
@@ -237,6 +245,113 @@ pub fn run_row(row: &Row, out: &Path, full_time: bool) -> Outcome {
         Err(_) => (None, None),
     };
     Outcome { row: row.clone(), result, wall, verdict, last_contact, out_dir: dir }
+}
+
+/// Particle rows through the thickness of the convergence study's three
+/// resolutions (issue #19; `plugsim validate --family convergence`): the
+/// coarse case with 12 rows (its coarsest spacing along the plate doubled
+/// with them, as the fine case halves it), the coarse case (24 rows) and
+/// the fine case (48 rows). Nothing else changes.
+pub const LADDER: [usize; 3] = [12, 24, 48];
+
+/// The convergence study's rows: every coarse axisymmetric member with
+/// \[RL10\]'s material (both experiments; the default model and
+/// \[RL10\]'s two criteria), each the 24-row rung of its ladder.
+pub fn convergence_rows() -> Vec<Row> {
+    coarse_rows()
+        .into_iter()
+        .filter(|r| r.case.geometry == "axisymmetric" && r.case.material == crate::cases::MATERIAL_RL10)
+        .collect()
+}
+
+/// The row and the overrides of `coarse`'s ladder at `layers` rows
+/// ([`LADDER`]): its fine sibling at 48.
+pub fn rung(coarse: &Row, layers: usize) -> (Row, Vec<String>) {
+    match layers {
+        48 => (Row::of(BorvikCase { discretization: "fine", ..coarse.case }), Vec::new()),
+        24 => (coarse.clone(), Vec::new()),
+        n => {
+            let spacing = 0.6e-3 * 24.0 / n as Real;
+            let set = vec![
+                format!("bodies.plate.rectangle.layers={n}"),
+                format!("bodies.plate.rectangle.coarse_spacing={spacing:e}"),
+            ];
+            (coarse.clone(), set)
+        }
+    }
+}
+
+/// One ladder: its coarse row and the outcome at each of [`LADDER`]'s
+/// resolutions, in that order.
+pub type Ladder = (Row, Vec<Outcome>);
+
+/// `(max − min) / mean` of the residual velocities over a ladder, if every
+/// rung perforated.
+pub fn residual_spread(outcomes: &[Outcome]) -> Option<Real> {
+    let v: Vec<Real> = outcomes.iter().map(|o| o.residual().filter(|&r| r > 0.0)).collect::<Option<_>>()?;
+    let (lo, hi) = v.iter().fold((Real::MAX, Real::MIN), |(a, b), &x| (a.min(x), b.max(x)));
+    Some((hi - lo) / (v.iter().sum::<Real>() / v.len() as Real))
+}
+
+/// The convergence table as Markdown and CSV: per ladder, the residual
+/// velocity, perforation time, plug mass and fastest particle at each
+/// resolution, the spread of the residuals and the finest one's error
+/// against the experiment.
+pub fn convergence_table(ladders: &[Ladder]) -> (String, String) {
+    let rows = |f: &dyn Fn(&Outcome) -> String, os: &[Outcome]| os.iter().map(f).collect::<Vec<_>>().join(" / ");
+    let mut md = String::from(
+        "| case | criterion | residual at 12 / 24 / 48 rows (m/s) | spread % | experiment (m/s) | error at 48 rows % | perforation (µs) | plug (g) | fastest particle (m/s) | smallest step / spacing step | wall (s) |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    let mut csv = String::from(
+        "case,criterion,rows,residual_m_s,outcome,experiment_m_s,perforation_us,plug_g,fastest_m_s,smallest_step_ratio,wall_s\n",
+    );
+    let residual = |o: &Outcome| match (&o.result, o.residual()) {
+        (Err(e), _) => format!("failed ({})", e.split(';').next().unwrap_or("")),
+        (Ok(_), Some(r)) if r > 0.0 => format!("{r:.1}"),
+        (Ok(_), Some(_)) => "held".into(),
+        (Ok(_), None) => match o.verdict {
+            Some(Verdict::Undecided { speed, .. }) => format!("undecided ({speed:.1})"),
+            _ => "—".into(),
+        },
+    };
+    let step_ratio = |o: &Outcome| {
+        o.result.as_ref().ok().and_then(|s| s.stable_step).map(|(base, (smallest, _, _))| smallest / base)
+    };
+    for (row, os) in ladders {
+        let e = row.experiment;
+        let finest = os.last().and_then(|o| o.residual()).filter(|&r| r > 0.0);
+        md.push_str(&format!(
+            "| {} | {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} |\n",
+            e.name,
+            row.case.criterion,
+            rows(&residual, os),
+            residual_spread(os).map_or_else(|| "—".into(), |s| format!("{:.1}", 100.0 * s)),
+            e.residual,
+            finest.map_or_else(|| "—".into(), |r| format!("{:+.1}", 100.0 * (r - e.residual) / e.residual)),
+            rows(&|o| fmt_opt(o.perforation().map(|t| t * 1e6), 1), os),
+            rows(&|o| fmt_opt(o.plug_mass(), 1), os),
+            rows(&|o| fmt_opt(o.fastest(), 0), os),
+            rows(&|o| fmt_opt(step_ratio(o), 2), os),
+            rows(&|o| format!("{:.0}", o.wall), os),
+        ));
+        for (layers, o) in LADDER.iter().zip(os) {
+            csv.push_str(&format!(
+                "{},{},{},{},{},{},{},{},{},{},{:.1}\n",
+                e.name,
+                row.case.criterion,
+                layers,
+                fmt_csv(o.residual(), 2),
+                residual(o).replace(',', ";"),
+                e.residual,
+                fmt_csv(o.perforation().map(|t| t * 1e6), 3),
+                fmt_csv(o.plug_mass(), 2),
+                fmt_csv(o.fastest(), 1),
+                fmt_csv(step_ratio(o), 3),
+                o.wall,
+            ));
+        }
+    }
+    (md, csv)
 }
 
 fn fmt_opt(v: Option<Real>, digits: usize) -> String {
@@ -445,9 +560,9 @@ mod tests {
 
     #[test]
     fn every_row_is_a_built_in_case_of_its_experiment() {
-        assert_eq!(coarse_rows().len(), 8);
+        assert_eq!(coarse_rows().len(), 10);
         let rows = all_rows();
-        assert_eq!(rows.len(), 20);
+        assert_eq!(rows.len(), 24);
         for r in &rows {
             let text = builtin_case(&r.id).unwrap();
             let case = Case::from_str_with(text, &r.id, &[]).unwrap_or_else(|e| panic!("{}: {e}", r.id));
@@ -469,14 +584,33 @@ mod tests {
         }
     }
 
+    /// The ladder: 12 rows by overrides of the coarse case (its coarsest
+    /// spacing doubled), the coarse case, the fine sibling; and the spread.
+    #[test]
+    fn convergence_ladder_rungs() {
+        let rows = convergence_rows();
+        assert_eq!(rows.len(), 6, "two experiments x three criteria, axisymmetric");
+        let r = rows.iter().find(|r| r.id == "borvik-2-axisymmetric-nonlocal").unwrap();
+        let (a, set) = rung(r, 12);
+        assert_eq!(a.id, r.id);
+        let case = Case::from_str_with(builtin_case(&a.id).unwrap(), &a.id, &set).unwrap();
+        assert_eq!(case.bodies[0].rectangle.layers, 12);
+        assert!((case.bodies[0].rectangle.coarse_spacing.unwrap() - 1.2e-3).abs() < 1e-15);
+        let (b, set) = rung(r, 24);
+        assert_eq!((b.id.as_str(), set.len()), (r.id.as_str(), 0));
+        let (c, set) = rung(r, 48);
+        assert_eq!((c.id.as_str(), set.len()), ("borvik-2-axisymmetric-fine-nonlocal", 0));
+    }
+
     #[test]
     fn only_selects_a_name_an_alias_or_every_name_containing_the_text() {
         let ids = |v: Vec<Row>| v.into_iter().map(|r| r.id).collect::<Vec<_>>();
         assert_eq!(ids(select(all_rows(), "borvik-1-axisymmetric")), ["borvik-1-axisymmetric"]);
         assert_eq!(ids(select(all_rows(), "borvik-2")), ["borvik-2-plane-strain"]);
         assert_eq!(select(all_rows(), "modified").len(), 4);
-        assert_eq!(select(all_rows(), "fine").len(), 12);
+        assert_eq!(select(all_rows(), "fine").len(), 14);
         assert_eq!(select(coarse_rows(), "damage").len(), 4);
+        assert_eq!(select(all_rows(), "nonlocal").len(), 4);
         assert!(select(all_rows(), "nosuch").is_empty());
     }
 }

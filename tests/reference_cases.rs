@@ -22,7 +22,8 @@ fn load(name: &str) -> Case {
 fn the_family_is_complete_and_every_member_parses_and_validates() {
     let family = borvik_family();
     // 2 cases x 2 geometries x 2 discretizations x 2 criteria + 2 x 2 modified
-    assert_eq!(family.len(), 16 + 4);
+    // + 2 x 2 with the default model (axisymmetric, coarse and fine)
+    assert_eq!(family.len(), 16 + 4 + 4);
     let names: Vec<String> = family.iter().map(|m| m.name()).collect();
     let mut unique = names.clone();
     unique.sort();
@@ -39,6 +40,12 @@ fn the_family_is_complete_and_every_member_parses_and_validates() {
                     let modified = usize::from(g == "axisymmetric" && d == "fine");
                     assert_eq!(n, 1 + modified, "case {e} {g} {d} {c}");
                 }
+                let n = family
+                    .iter()
+                    .filter(|m| m.experiment == e && m.geometry == g && m.discretization == d)
+                    .filter(|m| m.criterion == "nonlocal_damage")
+                    .count();
+                assert_eq!(n, usize::from(g == "axisymmetric"), "case {e} {g} {d}, default model");
             }
         }
     }
@@ -47,7 +54,11 @@ fn the_family_is_complete_and_every_member_parses_and_validates() {
         let mode = if m.geometry == "plane_strain" { GeometryMode::PlaneStrain } else { GeometryMode::Axisymmetric };
         assert_eq!(case.geometry.mode, mode, "{}", m.name());
         assert_eq!(case.bodies[0].rectangle.layers, if m.discretization == "coarse" { 24 } else { 48 });
-        let criterion = if m.criterion == "damage" { Criterion::Damage } else { Criterion::EffectiveStrain };
+        let criterion = match m.criterion {
+            "damage" => Criterion::Damage,
+            "nonlocal_damage" => Criterion::NonlocalDamage,
+            _ => Criterion::EffectiveStrain,
+        };
         assert_eq!(case.fracture.criterion, criterion, "{}", m.name());
         assert_eq!(case.bodies[0].material, m.material, "{}", m.name());
     }
