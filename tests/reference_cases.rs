@@ -198,7 +198,7 @@ fn coarse_case_one_cracks_at_both_corners_and_slows_the_projectile() {
 /// perforation time, [RL10] giving none for these experiments).
 #[test]
 fn nose_shape_cases_share_the_family_parameters_and_keep_reflections_out() {
-    let reference = load("borvik-1-axisymmetric");
+    let reference = load("borvik-1-axisymmetric-nonlocal");
     let r0 = &reference.bodies[0].rectangle;
     let mut noses = Vec::new();
     for name in BORVIK_NOSE_CASES {
