@@ -241,8 +241,8 @@ pub struct BorvikCase {
     pub geometry: &'static str,
     /// `"coarse"` (24 rows) or `"fine"` (48 rows).
     pub discretization: &'static str,
-    /// `"effective_strain"` or `"damage"` ([RL10]'s, the paper's mode), or
-    /// `"nonlocal_damage"` (the default model, axisymmetric with [RL10]'s
+    /// `"effective_strain"` or `"damage"` (\[RL10\]'s, the paper's mode), or
+    /// `"nonlocal_damage"` (the default model, axisymmetric with \[RL10\]'s
     /// material only).
     pub criterion: &'static str,
     /// The built-in material: [`MATERIAL_RL10`] or [`MATERIAL_MODIFIED`].

@@ -229,7 +229,7 @@ fn edge_weighted(inner: usize, outer: usize) -> Real {
 /// ([`RectangleGrid::generate`]: the larger neighbouring gap of its column
 /// and of its row; rows are uniform) and contributes to a point within
 /// `a_i` of it along both axes (the tensor-product window is zero on its
-/// edge, where rounding lets about half in: [`edge_weighted`]). So the entries of all points at one abscissa `x` are
+/// edge, where rounding lets about half in: `edge_weighted`). So the entries of all points at one abscissa `x` are
 /// `Σ_{i: |x − x_i| < a_i} Y(a_i)`, with `Y(a)` the number of
 /// (point row, particle row) pairs closer than `a`, which depends on `a`
 /// alone and is counted once per distinct support.

@@ -16,7 +16,7 @@
 //! ω_max² ≤ max_I ω_I²,
 //! ω_I² = Σ_q k_q w_q (|b_I(q)|/√m_I) Σ_J |b_J(q)|/√m_J  ≥  Σ_J |K_IJ| / √(m_I m_J)
 //! ```
-//! with `k_q` the point's modulus ([`point_modulus`]) and `b_I(q)` the
+//! with `k_q` the point's modulus (`point_modulus`) and `b_I(q)` the
 //! particle's column of the strain operator at point `q`: the spatial
 //! gradient `F⁻ᵀ ∇_X N_I` and, in axisymmetry, the hoop entry
 //! `N_I / (F_θθ R_q)`, so that compression (the impact face of a Taylor
@@ -77,7 +77,7 @@ fn column_norm(grad: &Vec2, n: Real, f_inv: Option<&Block2>, hoop: Option<Real>)
 
 /// Gershgorin bound `ω_I²` of every particle (module doc), rad²/s², in the
 /// reference configuration (`deformed = false`) or the current one, with
-/// each point's modulus from [`point_modulus`] (`fracturing`: crack growth
+/// each point's modulus from `point_modulus` (`fracturing`: crack growth
 /// is on, so fractured points carry pressure only). The row of a particle
 /// is that of its free components: none for one held in both (a clamp),
 /// and for one held radially (the axis, a roller) its axial row, whose

@@ -234,7 +234,7 @@ pub struct CrackGrowth {
     #[serde(skip)]
     grid: Option<CellGrid>,
     /// Quadrature rows built with a reduced basis (too few visible
-    /// particles next to a crack; [`super::rows`]).
+    /// particles next to a crack; [`crate::shape::rebuild_rows`]).
     pub reduced_quadrature_rows: BTreeMap<usize, Basis>,
     /// Particle rows built with a reduced basis.
     pub reduced_particle_rows: BTreeMap<usize, Basis>,

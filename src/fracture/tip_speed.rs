@@ -1,7 +1,7 @@
 //! The crack tip's speed limited by the material (issue #19; deviation
 //! from SPEC §9, module doc of [`crate::fracture`]).
 //!
-//! [RL10]'s tip jumps to the best candidate within `R ≈ 2.5 h` in any step
+//! \[RL10\]'s tip jumps to the best candidate within `R ≈ 2.5 h` in any step
 //! whose material ahead meets the criterion: up to `R/Δt`, hundreds of
 //! km/s at the CFL step, whereas no crack outruns the Rayleigh wave
 //! (`c_R ≈ 2.9 km/s` in steel; Freund, *Dynamic Fracture Mechanics*, 1990,

@@ -149,7 +149,7 @@ fn row_of_size<const M: usize>(
 }
 
 /// The row at `x` from the visible covering particles `cand` with `basis`
-/// ([`row_of_size`]); `Err(condition number)` if its moment matrix is
+/// (`row_of_size`); `Err(condition number)` if its moment matrix is
 /// singular.
 pub fn row_with_basis(
     x: &Vec2,
