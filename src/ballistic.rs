@@ -722,7 +722,13 @@ pub fn plot(study: &Study, title: &str, experiments: &[(Real, Real)]) -> LinePlo
         |p: &mut dyn Iterator<Item = (Real, Real)>| p.flat_map(|q| [q, (Real::NAN, Real::NAN)]).collect::<Vec<_>>();
     let mut series = vec![Series {
         name: "simulated".into(),
-        points: dots(&mut study.shots.iter().filter_map(|s| s.residual().map(|v| (s.speed, v)))),
+        // Runs counted held (stopped, or undecided without a plug) at 0.
+        points: dots(
+            &mut study
+                .shots
+                .iter()
+                .filter_map(|s| s.residual().or((!s.perforated()).then_some(0.0)).map(|v| (s.speed, v))),
+        ),
     }];
     if let Some(f) = &study.fit {
         let v_max = study
@@ -835,6 +841,24 @@ mod tests {
         assert_eq!(bracket(&shots), (Some(150.0), Some(170.0), Some(180.0)));
         let limit = Limit { held: Some(150.0), perforated: Some(170.0), tol: 1.0, non_monotonic: None };
         assert_eq!(limit.estimate(), Some((160.0, 10.0)));
+    }
+
+    #[test]
+    fn the_plot_draws_held_runs_at_zero_and_skips_plugs_still_pushed() {
+        let perf = |v| Verdict::Perforated { residual: v, since: 0.0 };
+        let undecided = |plug| Verdict::Undecided { speed: 5.0, plug, free: false };
+        let study = Study {
+            shots: vec![
+                shot(100.0, Verdict::Held { since: 0.0 }),
+                shot(120.0, undecided(false)),
+                shot(140.0, undecided(true)),
+                shot(200.0, perf(120.0)),
+            ],
+            ..Study::default()
+        };
+        let plot = plot(&study, "t", &[]);
+        let drawn: Vec<(Real, Real)> = plot.series[0].points.iter().copied().filter(|p| p.0.is_finite()).collect();
+        assert_eq!(drawn, vec![(100.0, 0.0), (120.0, 0.0), (200.0, 120.0)]);
     }
 
     #[test]

@@ -201,6 +201,13 @@ const MARGIN: u32 = 20;
 const X_LABEL_AREA: u32 = 60;
 const Y_LABEL_AREA: u32 = 100;
 
+/// The caption's font size, px: 28, or smaller so that `title` fits in 95 %
+/// of the image's `width` (px) at an average glyph width of 0.55 em.
+fn caption_size(title: &str, width: u32) -> u32 {
+    let fit = 0.95 * width as f64 / (0.55 * title.chars().count().max(1) as f64);
+    (fit.floor() as u32).clamp(12, 28)
+}
+
 fn draw_line_plot(root: &Area, plot: &LinePlot) -> Result<(), String> {
     let xs = plot.series.iter().flat_map(|s| s.points.iter().map(|p| p.0));
     let ys = plot.series.iter().flat_map(|s| s.points.iter().map(|p| p.1)).chain(plot.hlines.iter().map(|h| h.1));
@@ -210,7 +217,7 @@ fn draw_line_plot(root: &Area, plot: &LinePlot) -> Result<(), String> {
     let mut builder = ChartBuilder::on(root);
     builder.margin(MARGIN).x_label_area_size(X_LABEL_AREA).y_label_area_size(Y_LABEL_AREA);
     if !plot.title.is_empty() {
-        builder.caption(&plot.title, (FONT, 28));
+        builder.caption(&plot.title, (FONT, caption_size(&plot.title, root.dim_in_pixel().0)));
     }
     let mut chart = builder.build_cartesian_2d(x0..x1, y0..y1).map_err(|e| e.to_string())?;
     let x_ticks = tick_formatter(x0, x1);
@@ -570,6 +577,15 @@ mod tests {
         let width = u32::from_be_bytes(bytes[16..20].try_into().unwrap());
         let height = u32::from_be_bytes(bytes[20..24].try_into().unwrap());
         (width, height)
+    }
+
+    #[test]
+    fn a_long_caption_shrinks_to_the_width_a_short_one_keeps_its_size() {
+        assert_eq!(caption_size("Plug velocity", 1000), 28);
+        let long = "x".repeat(120);
+        let size = caption_size(&long, 1000);
+        assert!(size < 28 && 0.55 * size as f64 * 120.0 <= 0.95 * 1000.0, "{size}");
+        assert_eq!(caption_size(&"x".repeat(1000), 1000), 12);
     }
 
     fn sample_line_plot() -> LinePlot {
