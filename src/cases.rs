@@ -206,7 +206,7 @@ pub const BUILTIN_CASES: &[(&str, &str, &str)] = &[
     (
         "taylor-42crmo4-287",
         include_str!("../cases/taylor-42crmo4-287.toml"),
-        "Taylor anvil test: 42CrMo4 steel, 287 m/s (DynELA/Abaqus benchmark), axisymmetric, rigid wall",
+        "Taylor anvil test: 42CrMo4 steel, 287 m/s (DynELA/Abaqus benchmark), axisymmetric, face held on the wall as in the references",
     ),
 ];
 

@@ -5,7 +5,7 @@ use plugsim::case::Case;
 use plugsim::cases::builtin_case;
 use plugsim::math::{Real, Vec2};
 use plugsim::run::build_simulation;
-use plugsim::taylor::{measure, resolution_overrides, run_test, TAYLOR_TESTS};
+use plugsim::taylor::{measure, resolution_overrides, run_test, Wall, TAYLOR_TESTS};
 
 fn test_named(name: &str) -> &'static plugsim::taylor::TaylorTest {
     TAYLOR_TESTS.iter().find(|t| t.case == name).unwrap()
@@ -45,23 +45,24 @@ fn measure_reads_length_diameter_and_peaks_of_a_uniformly_stretched_bar() {
     assert!((last.0 - 1.2 * t.diameter / 2.0).abs() < 1e-12 && (last.1 - 0.9 * t.length).abs() < 1e-12, "{last:?}");
 }
 
-/// Issue #20: a contact layer must not manufacture plastic work; the peak
-/// on the impact face should stay within 10 % of the interior's and of the
-/// code-to-code reference (DynELA 1.78, Abaqus 1.81, at the face's centre
-/// element). Fails today: at the defaults (variable stable step) the 0.2 mm
-/// run gives a face peak of 2.23 at the axis against 2.02 in the interior
-/// (2.29 against 2.03 with `time.safety_factor = 0.1`). The cause
-/// (docs/validation.md, "Taylor anvil tests"): the face's centre lifts off
-/// the wall under the axial tension the converging lateral release leaves
-/// on the axis, and its re-impact converges on the axis point, whose
-/// plastic strain then grows with refinement (0.94, 1.27, 1.96 at 0.2, 0.1,
-/// 0.05 mm, 5 µs) while its deformation converges. Minutes in the test
-/// profile: `cargo test --release --test taylor -- --ignored`.
+/// Issue #20 item 5: the peak plastic strain on the impact face stays
+/// within 10 % of the interior's (two spacings and more from the face) and
+/// of the code-to-code reference (DynELA 1.78, Abaqus 1.81, at the face's
+/// centre element), for `taylor-42crmo4-287` with its face held axially as
+/// the reference codes hold it ([`plugsim::taylor::Wall::Restrained`]).
+/// Measured at 0.4 mm: face 1.93 against 1.83 in the interior (+5.3 %),
+/// +6.6 % against Abaqus. With the contact anvil instead (the case before
+/// the wall was held), the face's centre lifts off under the axial tension
+/// of the converging lateral release and re-impacts on the axis, and both
+/// assertions fail: face 2.10 against 1.91 (+10.4 %), +16 % against
+/// Abaqus (0.2 mm: 2.23 against 2.02, +10.3 %, and +23 % against Abaqus;
+/// docs/validation.md, "Taylor anvil tests"). At 0.4 mm (seconds); `plugsim validate --family taylor`
+/// measures 0.2 and 0.1 mm (1.94 / 1.90 and 1.93 / 1.90).
 #[test]
-#[ignore = "fails: the impact face's centre re-impacts on the axis (issue #20, docs/validation.md)"]
 fn impact_face_peak_plastic_strain_stays_near_the_interior() {
     let t = test_named("taylor-42crmo4-287");
-    let o = run_test(t, ("medium", 0.2e-3), &[]);
+    assert_eq!(t.wall, Wall::Restrained);
+    let o = run_test(t, ("coarse", 0.4e-3), &[]);
     assert!(o.failure.is_none(), "{:?}", o.failure);
     let m = o.measurement.unwrap();
     let reference: Real = 1.81;
@@ -102,4 +103,95 @@ fn measure_reads_the_bar_of_the_rod_on_rod_case_alone() {
     let m = measure(&sim.model);
     assert!((m.final_length - 0.9 * t.length).abs() < 1e-9 * t.length, "{}", m.final_length);
     assert!(m.peak_plastic_strain < 9.0);
+}
+
+/// A 42CrMo4 slab in uniaxial strain (plane strain, every particle held
+/// across) at 287 m/s onto a rigid, frictionless wall, 0.2 mm particles, to
+/// 0.45 µs (the plastic wave, about 4.7 mm/µs, has passed 2 mm; the elastic
+/// precursor has not come back from the far end). `wall`: the prescribed
+/// anvil met through contact, or the face row held axially.
+fn uniaxial_strain_impact(wall: Wall) -> plugsim::step::Simulation {
+    let anvil = "[[rigid_bodies]]\nname = \"anvil\"\nrectangle = { center = [0.0, -0.00501], width = 0.04, height = 0.01 }\nprescribed = true\nmass = 1.0\nvelocity = [0.0, 0.0]\n";
+    let held =
+        "[[bodies.supports]]\nregion = { x_min = 0.0, x_max = 0.0016, y_min = -1.0e-6, y_max = 1.0e-6 }\nfix = \"y\"\n";
+    let text = format!(
+        r#"
+title = "42CrMo4 slab in uniaxial strain on a rigid wall, 287 m/s"
+[geometry]
+mode = "plane_strain"
+[[bodies]]
+name = "bar"
+material = "steel_42crmo4"
+[bodies.rectangle]
+x_min = 0.0
+x_max = 0.0016
+y_min = 0.0
+y_max = 0.006
+layers = 31
+fine_half_width = 0.02
+fine_spacing = 0.0002
+[[bodies.initial_velocity]]
+velocity = [0.0, -287.0]
+[[bodies.supports]]
+region = {{ x_min = 0.0, x_max = 0.0016, y_min = 0.0, y_max = 0.006 }}
+fix = "x"
+{}
+[fracture]
+criterion = "none"
+[heat]
+conduction = false
+[time]
+end = 0.45e-6
+"#,
+        if wall == Wall::Contact { anvil } else { held }
+    );
+    let case = Case::from_str_with(&text, "uniaxial-strain", &[]).unwrap().resolved();
+    let mut sim = build_simulation(&case).unwrap();
+    while sim.time < case.time.end * (1.0 - 1e-12) {
+        sim.step().unwrap();
+    }
+    sim
+}
+
+/// Issue #20 item 5, the contact layer alone: in uniaxial strain nothing
+/// pulls the face off the wall, so contact and a held face must give the
+/// same face layer. The independent answer: a point compressed
+/// monotonically along one flow direction has, whatever its rate law,
+/// `τ̄ + 3G ε̄p = 2G |ln λ|` (λ the axial stretch of `F`, Kirchhoff `τ̄`):
+/// the plastic strain its deformation accounts for. Points 1.3–1.6 mm from
+/// the face meet it to 1 %. The first rows do not, with either wall: the
+/// instantaneous velocity jump of the impact rings behind the front and
+/// yields them in reverse, some 0.025 of plastic strain more than the
+/// closed form (0.0625 against 0.0395 on the face row with contact, 0.0657
+/// against 0.0407 held); this is the impact's start-up, not the contact's,
+/// and the contact's face row stays within 10 % of the held one's.
+#[test]
+fn contact_layer_makes_no_plastic_work_in_uniaxial_strain() {
+    let material = plugsim::material::builtin("steel_42crmo4").unwrap();
+    let three_g = 3.0 * plugsim::material::Constitutive::shear_modulus(&material);
+    let face_row = |wall: Wall| {
+        let sim = uniaxial_strain_impact(wall);
+        let q = &sim.model.quad;
+        let mut face: Real = 0.0;
+        for k in 0..q.len() {
+            let f = q.f[k];
+            assert!(f.xx == 1.0 && f.xy == 0.0 && f.yx.abs() < 1e-8, "point {k}: F {f:?}");
+            let y = q.x0[k].y;
+            if y < 0.1e-3 {
+                face = face.max(q.eps_p[k]);
+            } else if (1.3e-3..1.6e-3).contains(&y) {
+                let tau = plugsim::math::von_mises(&q.tau[k].to_tensor());
+                let closed_form = (2.0 / 3.0 * three_g * f.yy.ln().abs() - tau) / three_g;
+                assert!(closed_form > 0.03, "point {k}: behind the plastic wave");
+                let e = q.eps_p[k];
+                assert!(
+                    (e - closed_form).abs() < 0.01 * closed_form,
+                    "{wall:?}, point {k} at {y}: {e} vs {closed_form}"
+                );
+            }
+        }
+        face
+    };
+    let (contact, held) = (face_row(Wall::Contact), face_row(Wall::Restrained));
+    assert!(held > 0.03 && (contact - held).abs() < 0.1 * held, "face row: contact {contact}, held {held}");
 }
