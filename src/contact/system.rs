@@ -16,7 +16,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::deformable::{DeformableMasters, SegmentContact};
-use super::force::{coulomb_cap, inverse_distance_weights, one_step_normal_force, stick_force, Spreading};
+use super::force::{coulomb_cap, gap_floor, inverse_distance_weights, one_step_normal_force, stick_force, Spreading};
 use super::rigid::RigidBody;
 use super::search::{check_pairing, search_rigid_polygon, Projection};
 use super::slave::{Pairing, SlaveSet};
@@ -394,10 +394,11 @@ impl ContactSystem {
     /// In the fine plane-strain Borvik Case I with the damage criterion the
     /// corner had penetrated six such particles by up to 0.25 mm (one
     /// spacing) when a crushed point inverted at 35.8 µs. Admitting them
-    /// before they penetrate keeps the contact surface the current one.
-    /// A particle that joins and never penetrates gets no force and changes
+    /// before they penetrate keeps the contact surface the current one; one
+    /// that joins already inside is held at its depth, not pushed out
+    /// ([`gap_floor`]). A particle that joins and never penetrates gets no force and changes
     /// nothing: runs whose interior particles never reach a body keep their
-    /// bits (tests `exposed_particles_join_the_slaves_and_are_pushed_out`,
+    /// bits (tests `exposed_particles_join_the_slaves_and_go_no_deeper`,
     /// `admitted_interior_slaves_that_never_penetrate_change_no_bits`).
     /// The check is one parallel pass over the particles with a bounding-box
     /// filter per body.
@@ -531,7 +532,9 @@ impl ContactSystem {
     ///    `g̃ < 0`.
     /// 2. Find the forces `F_c = f_n n + f_t t` of those pairs such that,
     ///    after the step, every gap point with `f_n > 0` lies on the master
-    ///    surface and every sticking one moves tangentially with the body
+    ///    surface (a pair that started the step inside beyond round-off: at
+    ///    its depth then, [`gap_floor`]) and every
+    ///    sticking one moves tangentially with the body
     ///    (`f_n ≥ 0`, `|f_t| ≤ μ f_n`): projected Gauss–Seidel over the pairs,
     ///    each update being the one-step force `−m g/Δt²` (and stick force
     ///    `−m v_t/Δt`) of the pair's remaining gap (velocity) with its own
@@ -650,12 +653,12 @@ impl ContactSystem {
                     Spreading::None | Spreading::ShapeFunction => &self.gap_w[rows(gap_rows)],
                 };
                 let (c_n, c_t) = row_compliance(input, &self.gap_w[rows(gap_rows)], force_w, &normal, &tangent);
+                let relative = vel - body.predicted_velocity();
+                let start_gap = gap - dt * relative.dot(&normal);
                 self.candidates.push(
-                    Candidate::new(s as u32, Master::Rigid(pairing), gap_rows, force_rows, gap, normal).with_motion(
-                        (vel - body.predicted_velocity()).dot(&tangent),
-                        c_n,
-                        c_t,
-                    ),
+                    Candidate::new(s as u32, Master::Rigid(pairing), gap_rows, force_rows, gap, normal)
+                        .with_motion(relative.dot(&tangent), c_n, c_t)
+                        .with_gap_floor(gap_floor(start_gap, input.spacing[s])),
                 );
             }
             self.slaves.set_pairing(k, found);
@@ -680,7 +683,7 @@ impl ContactSystem {
                 for &(j, w) in &self.gap_w[c.gap_rows.0 as usize..c.gap_rows.1 as usize] {
                     du += mobility(input, j as usize).component_mul(&f_contact[j as usize]) * w;
                 }
-                let gap = c.gap + dt * dt_v * c.normal.dot(&du);
+                let gap = (c.gap - c.gap_floor) + dt * dt_v * c.normal.dot(&du);
                 let f_n = (c.f_n + one_step_normal_force(c.mass_normal, gap, dt * dt_v)).max(0.0);
                 let v_t = c.slip_velocity + dt_v * c.tangent.dot(&du);
                 let (f_t, slipping) = coulomb_cap(c.f_t + stick_force(c.mass_tangent, v_t, dt_v), mu * f_n);
@@ -826,6 +829,9 @@ pub(super) struct Candidate {
     force_rows: (u32, u32),
     /// Contact-free predicted gap `g̃`, m.
     gap: Real,
+    /// The end-of-step gap the normal force restores, m (≤ 0):
+    /// [`gap_floor`] of the pair's start-of-step gap.
+    gap_floor: Real,
     normal: Vec2,
     tangent: Vec2,
     /// Contact-free predicted relative tangential velocity, m/s.
@@ -856,6 +862,7 @@ impl Candidate {
             gap_rows,
             force_rows,
             gap,
+            gap_floor: 0.0,
             normal,
             tangent: Vec2::new(-normal.y, normal.x),
             slip_velocity: 0.0,
@@ -873,6 +880,13 @@ impl Candidate {
         self.slip_velocity = slip_velocity;
         self.mass_normal = effective_mass(c_n);
         self.mass_tangent = effective_mass(c_t);
+        self
+    }
+
+    /// With the end-of-step gap `floor` (m, ≤ 0, [`gap_floor`]) as the
+    /// target of the normal force instead of 0.
+    pub(super) fn with_gap_floor(mut self, floor: Real) -> Self {
+        self.gap_floor = floor;
         self
     }
 }
