@@ -132,7 +132,6 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::force::gap_floor;
 use super::system::{predict_gap_point, row_compliance, Candidate, GapPoint, Master, StepInput};
 use super::{ContactError, Spreading};
 use crate::math::{Real, Vec2};
@@ -681,7 +680,7 @@ impl DeformableMasters {
             out.push(
                 Candidate::new(slave, Master::Segment { segment: [a, b], lambda }, rows, rows, gap, normal)
                     .with_motion(relative.dot(&tangent), c_n, c_t)
-                    .with_gap_floor(gap_floor(start_gap, h)),
+                    .with_start_gap(start_gap, h),
             );
         }
         Ok(())

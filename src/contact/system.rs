@@ -658,7 +658,7 @@ impl ContactSystem {
                 self.candidates.push(
                     Candidate::new(s as u32, Master::Rigid(pairing), gap_rows, force_rows, gap, normal)
                         .with_motion(relative.dot(&tangent), c_n, c_t)
-                        .with_gap_floor(gap_floor(start_gap, input.spacing[s])),
+                        .with_start_gap(start_gap, input.spacing[s]),
                 );
             }
             self.slaves.set_pairing(k, found);
@@ -883,10 +883,12 @@ impl Candidate {
         self
     }
 
-    /// With the end-of-step gap `floor` (m, ≤ 0, [`gap_floor`]) as the
-    /// target of the normal force instead of 0.
-    pub(super) fn with_gap_floor(mut self, floor: Real) -> Self {
-        self.gap_floor = floor;
+    /// With the pair's gap at the start of the step, `start_gap` (m, with
+    /// the pair's own master point and normal), and the slave's `spacing`
+    /// (m): the normal force's end-of-step target becomes
+    /// [`gap_floor`]`(start_gap, spacing)` instead of 0.
+    pub(super) fn with_start_gap(mut self, start_gap: Real, spacing: Real) -> Self {
+        self.gap_floor = gap_floor(start_gap, spacing);
         self
     }
 }
