@@ -471,7 +471,7 @@ fn validate_convergence(out: &Path, only: Option<&str>) -> Result<()> {
 /// `plugsim validate --family taylor`: the Taylor anvil tests at two (three
 /// with `--all`) resolutions, table, CSV and profile plots into `out`.
 fn validate_taylor(out: &Path, all: bool, only: Option<&str>, set: &[String]) -> Result<()> {
-    use plugsim::taylor::{profile_plot, run_test, symmetry_table, table, METHODS, RESOLUTIONS, TAYLOR_TESTS};
+    use plugsim::taylor::{methods, profile_plot, run_test, symmetry_table, table, RESOLUTIONS, TAYLOR_TESTS};
     let picked = |case: &str| only.is_none_or(|o| case.contains(o));
     // A rod-on-rod case brings its anvil twin, which it is compared with.
     let tests: Vec<_> = TAYLOR_TESTS
@@ -519,7 +519,7 @@ fn validate_taylor(out: &Path, all: bool, only: Option<&str>, set: &[String]) ->
     } else {
         String::new()
     };
-    let report = format!("{header}\n\n{md}\n{symmetry}{METHODS}\n\n{plots}");
+    let report = format!("{header}\n\n{md}\n{symmetry}{}\n\n{plots}", methods());
     std::fs::write(out.join("taylor.md"), &report)?;
     std::fs::write(out.join("taylor.csv"), &csv)?;
     println!("{report}");
