@@ -53,10 +53,11 @@
 //! it cannot read; the length and the checksum are checked before anything
 //! is decoded. A reader refuses every version but its own
 //! ([`CheckpointError::Version`]): versions 1 to 3 were hand-written
-//! sections of columns, versions 4 to 7 the postcard encoding (5 adds the
+//! sections of columns, versions 4 to 8 the postcard encoding (5 adds the
 //! run's fastest particle, 6 the crack-tip allowance, the crack stage's last
 //! time and the non-local fracture parameters, issue #19; 7 the adaptive
-//! stable step and the deformable contact, issues #19 and #20). The payload is
+//! stable step and the deformable contact, issues #19 and #20; 8 the crack
+//! events' own damage, [`crate::fracture::CrackEvent::damage`]). The payload is
 //! [postcard](https://docs.rs/postcard) 1.x, whose wire format is stable
 //! within the major version: fields in declaration order, no names; an
 //! `f64` as its eight IEEE-754 bytes, so values (NaN payloads, −0.0)
@@ -128,8 +129,9 @@ pub const MAGIC: [u8; 8] = *b"PLUGCKPT";
 /// crack-tip allowance and the non-local fracture parameters, version 7
 /// the adaptive stable step (`Simulation::stable`, `dt_previous`) and the
 /// deformable contact (its masters, persistent pairs and work, the
-/// `deformable` and `self_contact` switches; issue #20).
-pub const FORMAT_VERSION: u32 = 7;
+/// `deformable` and `self_contact` switches; issue #20), version 8 the
+/// crack events' own damage ([`crate::fracture::CrackEvent::damage`]).
+pub const FORMAT_VERSION: u32 = 8;
 /// Subdirectory of a run's output directory that holds its checkpoints.
 pub const DIRECTORY: &str = "checkpoints";
 /// File name extension of a checkpoint.

@@ -68,8 +68,9 @@ pub const HISTORY_COLUMNS: &[&str] = &[
 /// split particle (left child), the new right child and, for nucleate and
 /// propagate, the new tip, separated by spaces; `value` is the criterion
 /// value of the new tip (of the split tip at arrest; empty for an inserted
-/// pre-crack).
-pub const CRACK_COLUMNS: &[&str] = &["time", "step", "crack", "kind", "particles", "value"];
+/// pre-crack) and `damage` that particle's own Johnson–Cook damage
+/// ([`crate::fracture::CrackEvent::damage`]; empty likewise).
+pub const CRACK_COLUMNS: &[&str] = &["time", "step", "crack", "kind", "particles", "value", "damage"];
 
 /// Per-rigid-body history column suffixes.
 pub const RIGID_COLUMNS: &[&str] = &["x", "y", "vx", "vy", "fx", "fy", "contacts", "f_axial"];
@@ -461,9 +462,20 @@ impl OutputWriter {
         let f = self.crack_log.as_mut().expect("opened");
         for e in &cracks.events[self.crack_events_written..] {
             let ids: Vec<String> = e.particles.iter().map(|i| i.to_string()).collect();
-            let value = if e.value.is_finite() { format!("{:.6e}", e.value) } else { String::new() };
-            writeln!(f, "{:.9e},{},{},{},{},{}", e.time, e.step, e.crack, e.kind.name(), ids.join(" "), value)
-                .map_err(err)?;
+            let num = |v: Real| if v.is_finite() { format!("{v:.6e}") } else { String::new() };
+            let (value, damage) = (num(e.value), num(e.damage));
+            writeln!(
+                f,
+                "{:.9e},{},{},{},{},{},{}",
+                e.time,
+                e.step,
+                e.crack,
+                e.kind.name(),
+                ids.join(" "),
+                value,
+                damage
+            )
+            .map_err(err)?;
         }
         f.flush().map_err(err)?;
         self.crack_events_written = cracks.events.len();

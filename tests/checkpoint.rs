@@ -286,6 +286,7 @@ fn crack_state_round_trips_bit_for_bit() {
             kind: plugsim::fracture::EventKind::Nucleate,
             particles: vec![k, 2 * k],
             value,
+            damage: -value,
         });
     }
     // Events must name an existing crack.
@@ -392,19 +393,19 @@ fn checkpoint_of_another_format_version_is_refused_naming_both() {
     }
 }
 
-/// Format 6 (postcard, before the adaptive stable step) is refused,
+/// Format 7 (postcard, before the crack events' own damage) is refused,
 /// naming both versions, rather than misread.
 #[test]
 fn older_format_version_checkpoint_is_refused_naming_both_versions() {
-    assert_eq!(FORMAT_VERSION, 7);
+    assert_eq!(FORMAT_VERSION, 8);
     let case = case(STRIKE, &["time.end=1e-6"]);
-    let dir = scratch("version-6");
+    let dir = scratch("version-7");
     let path = run_until(&case, &dir, 2);
-    corrupt(&path, 8, &6u32.to_le_bytes());
+    corrupt(&path, 8, &7u32.to_le_bytes());
     let e = checkpoint::read(&path).unwrap_err().to_string();
-    assert!(e.contains("format version 6 ") && e.contains("reads format version 7"), "{e}");
+    assert!(e.contains("format version 7 ") && e.contains("reads format version 8"), "{e}");
     let e = resume(&config(&dir, None), &mut |_| {}).unwrap_err().to_string();
-    assert!(e.contains("format version 6 ") && e.contains("format version 7"), "{e}");
+    assert!(e.contains("format version 7 ") && e.contains("format version 8"), "{e}");
 }
 
 #[test]

@@ -196,6 +196,38 @@ fn splits_conserve_mass_and_momentum_and_reproduction() {
     }
 }
 
+/// Every crack event records the deciding particle's own damage, whatever
+/// the criterion: the lumped projection of the points' `D`, exact for a
+/// constant field (here 0.37 everywhere while the effective strain decides);
+/// with the damage criterion it is the criterion value itself.
+#[test]
+fn crack_events_record_the_tips_own_damage() {
+    let (nx, ny) = (25, 9);
+    let top = (ny - 1) as Real * H;
+    let xc = 10.0 * H;
+    let band = move |x: &Vec2| 0.6 * (-((x.x - xc - 0.4 * (top - x.y)) / H).powi(2)).exp();
+    let mut m = plate(nx, ny);
+    set_field(&mut m, band);
+    m.quad.damage.iter_mut().for_each(|d| *d = 0.37);
+    let mut g = CrackGrowth::new(params(Criterion::EffectiveStrain));
+    drive(&mut m, &mut g, 30);
+    assert!(g.events.len() >= 4, "{:?}", g.events);
+    for e in &g.events {
+        assert!((e.damage - 0.37).abs() < 1e-12, "{e:?}");
+        assert!(e.value >= 0.3, "the effective strain decided: {e:?}");
+    }
+    let mut m = plate(nx, ny);
+    for q in 0..m.quad.len() {
+        m.quad.damage[q] = 2.0 * band(&m.quad.x0[q]);
+    }
+    let mut g = CrackGrowth::new(FractureParameters { critical_damage: 0.5, ..params(Criterion::Damage) });
+    drive(&mut m, &mut g, 30);
+    assert!(g.events.len() >= 4, "{:?}", g.events);
+    for e in &g.events {
+        assert!((e.damage - e.value).abs() <= 1e-12 * e.value.abs(), "{e:?}");
+    }
+}
+
 #[test]
 fn arrest_at_the_far_surface_without_running_along_it() {
     arrest_at_the_far_surface_in(GeometryMode::PlaneStrain);

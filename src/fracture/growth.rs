@@ -57,6 +57,16 @@ pub fn nodal_mass(model: &Model, i: usize) -> Real {
 
 /// The lumped projection of the quadrature values `col` at particle `i`,
 /// `Σ_q N_i(X_q) w_q c_q / Σ_q N_i(X_q) w_q` (0 without points).
+/// [`CrackEvent::damage`] of particle `i`: its lumped damage, NaN for an
+/// inserted pre-crack (whose `value` is NaN: no criterion decided it).
+fn tip_damage(model: &Model, i: usize, value: Real) -> Real {
+    if value.is_nan() {
+        Real::NAN
+    } else {
+        lumped_projection(model, i, &model.quad.damage)
+    }
+}
+
 fn lumped_projection(model: &Model, i: usize, col: &[Real]) -> Real {
     let (mut acc, mut wsum) = (0.0, 0.0);
     for j in model.gather.range(i) {
@@ -113,6 +123,13 @@ pub struct CrackEvent {
     /// Criterion value of the deciding particle (the new tip; the split
     /// tip at arrest).
     pub value: Real,
+    /// The deciding particle's own Johnson–Cook damage `D` (lumped
+    /// projection, module doc of [`crate::fracture`]), whatever the
+    /// criterion: how much of the locus the material the crack enters has
+    /// used. With `"damage"` it equals `value`; with `"nonlocal_damage"` it
+    /// shows whether the crack runs through a band (`D` well above the
+    /// average) or through diffuse material (`D ≈ D̄`, far below 1).
+    pub damage: Real,
 }
 
 /// A vertex of a crack path.
@@ -726,6 +743,7 @@ impl CrackGrowth {
             arrested: None,
             allowance: 0.0,
         });
+        let damage = tip_damage(model, j, value);
         let split = Split { parent: i, vertex: xi, incoming: d, outgoing: d, reach: (xj - xi).norm(), offset };
         let (l, r) = self.split(model, id, split)?;
         self.cracks[id].vertices[0].faces = Some((l as u32, r as u32));
@@ -736,6 +754,7 @@ impl CrackGrowth {
             kind: EventKind::Nucleate,
             particles: vec![l, r, j],
             value,
+            damage,
         });
         Ok(vec![l, r])
     }
@@ -758,6 +777,7 @@ impl CrackGrowth {
         let last_len = (xt - self.cracks[c].vertices[n - 2].x0).norm();
         self.cracks[c].vertices.push(CrackVertex { x0: xj, faces: None });
         self.cracks[c].tip = Some(j);
+        let damage = tip_damage(model, j, value);
         let split = Split {
             parent: tip,
             vertex: xt,
@@ -775,6 +795,7 @@ impl CrackGrowth {
             kind: EventKind::Propagate,
             particles: vec![l, r, j],
             value,
+            damage,
         });
         Ok(vec![l, r])
     }
@@ -783,6 +804,7 @@ impl CrackGrowth {
     fn arrest(&mut self, model: &mut Model, c: usize, time: Real, step: u64) -> Result<Vec<usize>, FractureError> {
         let tip = self.cracks[c].tip.expect("growing");
         let value = self.criterion_value(model, tip);
+        let damage = tip_damage(model, tip, value);
         let xt = model.particles.x0[tip];
         let d = self.cracks[c].direction();
         let n = self.cracks[c].vertices.len();
@@ -794,7 +816,15 @@ impl CrackGrowth {
         let split = Split { parent: tip, vertex: xt, incoming: d, outgoing: d, reach: last_len, offset };
         let (l, r) = self.split(model, c, split)?;
         self.cracks[c].vertices[n - 1].faces = Some((l as u32, r as u32));
-        self.events.push(CrackEvent { time, step, crack: c, kind: EventKind::Arrest, particles: vec![l, r], value });
+        self.events.push(CrackEvent {
+            time,
+            step,
+            crack: c,
+            kind: EventKind::Arrest,
+            particles: vec![l, r],
+            value,
+            damage,
+        });
         Ok(vec![l, r])
     }
 
