@@ -163,6 +163,9 @@ pub struct Shot {
     /// The largest physical particle speed of the run, m/s
     /// ([`crate::step::FastestParticle`]).
     pub fastest: Real,
+    /// Median own damage of the particles the cracks grew into
+    /// ([`crate::fracture::CrackGrowth::tip_damage`]; the locus is 1).
+    pub tip_damage: Option<Real>,
     pub steps: u64,
     /// Wall time, s.
     pub wall: Real,
@@ -457,6 +460,7 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
                     plug_mass: s.plug.as_ref().map(|p| p.mass),
                     end_time: s.time,
                     fastest: s.fastest.speed,
+                    tip_damage: s.tip_damage.map(|d| d.median),
                     steps: s.steps,
                     wall: t.elapsed().as_secs_f64(),
                     dir,
@@ -604,17 +608,18 @@ pub fn read_experiments(path: &Path) -> Result<Vec<(Real, Real)>, BallisticError
 
 /// The table as (Markdown, CSV).
 pub fn table(study: &Study) -> (String, String) {
-    let mut md = String::from("| v_i (m/s) | v_r (m/s) | outcome | perforation (us) | plug mass (kg; kg/m in plane strain) | end (us) | fastest particle (m/s) | steps | wall (s) |\n|---|---|---|---|---|---|---|---|---|\n");
+    let mut md = String::from("| v_i (m/s) | v_r (m/s) | outcome | perforation (us) | plug mass (kg; kg/m in plane strain) | end (us) | fastest particle (m/s) | crack-tip damage (median) | steps | wall (s) |\n|---|---|---|---|---|---|---|---|---|---|\n");
     let mut csv = String::from(
-        "v_i_m_s,v_r_m_s,perforated,outcome,perforation_us,plug_mass,end_us,fastest_particle_m_s,steps,wall_s,dir\n",
+        "v_i_m_s,v_r_m_s,perforated,outcome,perforation_us,plug_mass,end_us,fastest_particle_m_s,tip_damage_median,steps,wall_s,dir\n",
     );
     let opt = |v: Option<Real>, f: &dyn Fn(Real) -> String| v.map_or_else(String::new, f);
     for s in &study.shots {
         let vr = opt(s.residual(), &|v| format!("{v:.2}"));
         let perf = opt(s.perforation, &|t| format!("{:.2}", t * 1e6));
         let mass = opt(s.plug_mass, &|m| format!("{m:.5}"));
+        let tip = opt(s.tip_damage, &|d| format!("{d:.3}"));
         md.push_str(&format!(
-            "| {:.2} | {} | {} | {} | {} | {:.1} | {:.0} | {} | {:.1} |\n",
+            "| {:.2} | {} | {} | {} | {} | {:.1} | {:.0} | {} | {} | {:.1} |\n",
             s.speed,
             if vr.is_empty() { "—".into() } else { vr.clone() },
             s.outcome(),
@@ -622,11 +627,12 @@ pub fn table(study: &Study) -> (String, String) {
             if mass.is_empty() { "—".into() } else { mass.clone() },
             s.end_time * 1e6,
             s.fastest,
+            if tip.is_empty() { "—".into() } else { tip.clone() },
             s.steps,
             s.wall
         ));
         csv.push_str(&format!(
-            "{:.2},{vr},{},{},{perf},{mass},{:.3},{:.1},{},{:.2},{}\n",
+            "{:.2},{vr},{},{},{perf},{mass},{:.3},{:.1},{tip},{},{:.2},{}\n",
             s.speed,
             s.perforated(),
             s.outcome().replace(',', ";"),
@@ -824,6 +830,7 @@ mod tests {
             plug_mass: None,
             end_time: 0.0,
             fastest: 0.0,
+            tip_damage: None,
             steps: 0,
             wall: 0.0,
             dir: PathBuf::new(),

@@ -928,6 +928,12 @@ fn drive(
             None => println!("  crack {id}: nucleated at {:.3} us, still growing", nucleated * 1e6),
         }
     }
+    if let Some(d) = s.tip_damage {
+        println!(
+            "  crack tips grew into material at damage D = {:.3} / {:.3} / {:.3} (min / median / max of {} events; the locus is D = 1)",
+            d.min, d.median, d.max, d.count
+        );
+    }
     if let Some(t) = s.separation {
         println!("  plug separated at {:.3} us (its cracks arrested through the thickness)", t * 1e6);
     }

@@ -103,6 +103,9 @@ pub struct RunSummary {
     pub plots: Vec<PathBuf>,
     /// Each crack: id, nucleation time (s), arrest time (s) if it arrested.
     pub cracks: Vec<(usize, Real, Option<Real>)>,
+    /// The own damage of the particles the cracks grew into
+    /// ([`crate::fracture::CrackGrowth::tip_damage`]).
+    pub tip_damage: Option<crate::fracture::TipDamage>,
     /// When the plug separated (all cracks that cut it out arrested), s.
     pub separation: Option<Real>,
     /// Perforation: when the plug was first cut out of the plate (see
@@ -486,12 +489,13 @@ fn time_loop(
     plots.extend(crate::output::plot_history(&cfg.out_dir)?);
     plots.extend(crate::output::plot_fields(&sim, &cfg.out_dir)?);
     output_wall += t.elapsed();
-    let (cracks, separation) = match &sim.cracks {
+    let (cracks, separation, tip_damage) = match &sim.cracks {
         Some(c) => (
             c.cracks.iter().map(|k| (k.id, k.nucleated.0, k.arrested.map(|a| a.0))).collect(),
             c.separation_time(sim.model.mode),
+            c.tip_damage(),
         ),
-        None => (Vec::new(), None),
+        None => (Vec::new(), None, None),
     };
     let rigid_velocities: Vec<(String, [Real; 2])> = sim
         .contact
@@ -522,6 +526,7 @@ fn time_loop(
         eroded_points: sim.model.quad.eroded.iter().filter(|&&e| e).count(),
         exposed: crate::output::exposed_contact_summary(&history),
         cracks,
+        tip_damage,
         separation,
         rigid_velocities,
         last_contacts,

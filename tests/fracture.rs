@@ -196,6 +196,16 @@ fn splits_conserve_mass_and_momentum_and_reproduction() {
     }
 }
 
+#[test]
+fn tip_damage_summary_takes_min_median_max() {
+    use plugsim::fracture::TipDamage;
+    let odd = TipDamage::of(vec![0.3, 0.1, 0.2]).unwrap();
+    assert_eq!((odd.min, odd.median, odd.max, odd.count), (0.1, 0.2, 0.3, 3));
+    let even = TipDamage::of(vec![0.4, 0.1, 0.2, 0.3]).unwrap();
+    assert_eq!((even.min, even.median, even.max, even.count), (0.1, 0.25, 0.4, 4));
+    assert!(TipDamage::of(Vec::new()).is_none());
+}
+
 /// Every crack event records the deciding particle's own damage, whatever
 /// the criterion: the lumped projection of the points' `D`, exact for a
 /// constant field (here 0.37 everywhere while the effective strain decides);
@@ -216,6 +226,10 @@ fn crack_events_record_the_tips_own_damage() {
         assert!((e.damage - 0.37).abs() < 1e-12, "{e:?}");
         assert!(e.value >= 0.3, "the effective strain decided: {e:?}");
     }
+    let summary = g.tip_damage().unwrap();
+    let grown = g.events.iter().filter(|e| e.kind != EventKind::Arrest).count();
+    assert_eq!(summary.count, grown);
+    assert!((summary.min - 0.37).abs() < 1e-12 && (summary.max - 0.37).abs() < 1e-12, "{summary:?}");
     let mut m = plate(nx, ny);
     for q in 0..m.quad.len() {
         m.quad.damage[q] = 2.0 * band(&m.quad.x0[q]);

@@ -132,6 +132,31 @@ pub struct CrackEvent {
     pub damage: Real,
 }
 
+/// Summary of the own damage of the particles the cracks grew into
+/// ([`CrackGrowth::tip_damage`]): the locus is `D = 1`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TipDamage {
+    pub min: Real,
+    /// The median (the mean of the middle two for an even count).
+    pub median: Real,
+    pub max: Real,
+    /// Number of events.
+    pub count: usize,
+}
+
+impl TipDamage {
+    /// Summary of `values` (finite), `None` if empty.
+    pub fn of(mut values: Vec<Real>) -> Option<Self> {
+        if values.is_empty() {
+            return None;
+        }
+        values.sort_by(|a, b| a.partial_cmp(b).expect("finite damage"));
+        let n = values.len();
+        let median = if n % 2 == 1 { values[n / 2] } else { 0.5 * (values[n / 2 - 1] + values[n / 2]) };
+        Some(TipDamage { min: values[0], median, max: values[n - 1], count: n })
+    }
+}
+
 /// A vertex of a crack path.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CrackVertex {
@@ -402,6 +427,19 @@ impl CrackGrowth {
         } else {
             0.0
         }
+    }
+
+    /// How far along its locus the material was where the cracks grew:
+    /// the own damage ([`CrackEvent::damage`]) of the particles that
+    /// nucleation and propagation made tips, `None` before any.
+    pub fn tip_damage(&self) -> Option<TipDamage> {
+        let d: Vec<Real> = self
+            .events
+            .iter()
+            .filter(|e| e.kind != EventKind::Arrest && e.damage.is_finite())
+            .map(|e| e.damage)
+            .collect();
+        TipDamage::of(d)
     }
 
     /// Time of plug separation: when the through-cracks that cut a plug

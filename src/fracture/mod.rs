@@ -263,7 +263,7 @@ pub mod nonlocal;
 pub mod tip_speed;
 pub mod visibility;
 
-pub use growth::{Crack, CrackEvent, CrackGrowth, CrackVertex, EventKind};
+pub use growth::{Crack, CrackEvent, CrackGrowth, CrackVertex, EventKind, TipDamage};
 pub use visibility::{CrackSegments, CrackVisibility};
 
 use crate::math::Real;
