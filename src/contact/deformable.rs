@@ -135,6 +135,7 @@ use serde::{Deserialize, Serialize};
 use super::system::{predict_gap_point, row_compliance, Candidate, GapPoint, Master, StepInput};
 use super::{ContactError, Spreading};
 use crate::math::{Real, Vec2};
+use crate::neighbors::{CellGrid, CellLayout};
 use crate::particles::{ParticleFlags, Particles};
 use crate::shape::ShapeTable;
 
@@ -217,95 +218,42 @@ struct Scratch {
 /// A uniform grid of square cells, each listing the segments whose bounding
 /// boxes, grown by a reach, cover it: every point within the reach of a
 /// segment finds it in its own cell (the coarse search; no loop over all
-/// segments per slave). Counting-sorted into one array; rebuilt every step
-/// into the same allocations.
+/// segments per slave). A [`CellGrid`] filled with boxes, ascending segment
+/// indices in each cell; rebuilt every step into the same allocations.
 #[derive(Clone, Debug, Default, PartialEq)]
 struct SegmentGrid {
-    origin: Vec2,
-    cell: Real,
-    nx: usize,
-    ny: usize,
-    /// Cell `c = iy nx + ix` holds `items[start[c]..start[c + 1]]`,
-    /// ascending segment indices.
-    start: Vec<u32>,
-    items: Vec<u32>,
+    cells: CellGrid,
 }
 
 impl SegmentGrid {
-    /// Cells of the box `(lo, hi)` grown by `reach`, as inclusive ranges.
-    fn cells(&self, lo: &Vec2, hi: &Vec2, reach: Real) -> (usize, usize, usize, usize) {
-        let index = |v: Real, o: Real, n: usize| ((v - o) / self.cell).floor().clamp(0.0, (n - 1) as Real) as usize;
-        (
-            index(lo.x - reach, self.origin.x, self.nx),
-            index(hi.x + reach, self.origin.x, self.nx),
-            index(lo.y - reach, self.origin.y, self.ny),
-            index(hi.y + reach, self.origin.y, self.ny),
-        )
-    }
-
     /// Rebuild over `boxes` grown by `reach` (m, > 0), with cells of about
-    /// `reach` (enlarged so that there are at most `4 n + 64` of them).
-    /// False if a box is not finite.
+    /// `reach` (enlarged so that there are at most `4 n + 64` of them:
+    /// [`CellLayout::capped_cell`]). False if a box is not finite.
     fn fill(&mut self, boxes: &[(Vec2, Vec2)], reach: Real) -> bool {
         let finite = |v: &Vec2| v.x.is_finite() && v.y.is_finite();
         if boxes.is_empty() || !(reach.is_finite() && reach > 0.0) || !boxes.iter().all(|(a, b)| finite(a) && finite(b))
         {
             return false;
         }
+        let grow = Vec2::new(reach, reach);
         let (mut lo, mut hi) = boxes[0];
         for (a, b) in boxes {
             lo = lo.inf(a);
             hi = hi.sup(b);
         }
-        lo -= Vec2::new(reach, reach);
-        hi += Vec2::new(reach, reach);
-        let ext = hi - lo;
-        let max_cells = (4 * boxes.len() + 64) as Real;
-        let mut cell = reach;
-        while ((ext.x / cell).floor() + 1.0) * ((ext.y / cell).floor() + 1.0) > max_cells {
-            cell *= 2.0;
-        }
-        self.origin = lo;
-        self.cell = cell;
-        self.nx = (ext.x / cell).floor() as usize + 1;
-        self.ny = (ext.y / cell).floor() as usize + 1;
-        self.start.clear();
-        self.start.resize(self.nx * self.ny + 1, 0);
-        for (a, b) in boxes {
-            let (x0, x1, y0, y1) = self.cells(a, b, reach);
-            for iy in y0..=y1 {
-                for ix in x0..=x1 {
-                    self.start[iy * self.nx + ix + 1] += 1;
-                }
-            }
-        }
-        for c in 0..self.nx * self.ny {
-            self.start[c + 1] += self.start[c];
-        }
-        self.items.clear();
-        self.items.resize(self.start[self.nx * self.ny] as usize, 0);
-        let mut fill = self.start.clone();
-        for (k, (a, b)) in boxes.iter().enumerate() {
-            let (x0, x1, y0, y1) = self.cells(a, b, reach);
-            for iy in y0..=y1 {
-                for ix in x0..=x1 {
-                    let c = iy * self.nx + ix;
-                    self.items[fill[c] as usize] = k as u32;
-                    fill[c] += 1;
-                }
-            }
-        }
+        lo -= grow;
+        hi += grow;
+        let layout = CellLayout::new(lo, hi, CellLayout::capped_cell(hi - lo, reach, boxes.len()));
+        self.cells.fill(layout, boxes.len(), |k| {
+            let (a, b) = &boxes[k];
+            layout.cells_of_box(&(a - grow), &(b + grow))
+        });
         true
     }
 
     /// The segments listed in the cell of `p` (none outside the grid).
     fn at(&self, p: &Vec2) -> &[u32] {
-        let (fx, fy) = ((p.x - self.origin.x) / self.cell, (p.y - self.origin.y) / self.cell);
-        if !(fx >= 0.0 && fy >= 0.0 && fx < self.nx as Real && fy < self.ny as Real) {
-            return &[];
-        }
-        let c = fy as usize * self.nx + fx as usize;
-        &self.items[self.start[c] as usize..self.start[c + 1] as usize]
+        self.cells.items_at(p)
     }
 }
 

@@ -3,12 +3,14 @@
 //! "coarse" stage of the contact search; also the neighbour query of the
 //! surface detection).
 //!
-//! Points are counting-sorted by cell into one compressed array, so a grid is
-//! two allocations and queries never allocate. The grid is built once: the
-//! master vertices live in the rigid body's own frame (the body only
-//! translates), and the surface detection runs on a fixed particle set.
+//! The points are binned in a [`CellGrid`] (counting-sorted by cell into one
+//! compressed array), so a grid is three allocations and queries never
+//! allocate. The grid is built once: the master vertices live in the rigid
+//! body's own frame (the body only translates), and the surface detection
+//! runs on a fixed particle set.
 
 use crate::math::{Real, Vec2};
+use crate::neighbors::{bounding_box, CellGrid, CellLayout, CellRange};
 
 /// Relative safety margin on the ring-search stopping bound, so that a point
 /// whose cell index was rounded across a cell face can never be skipped.
@@ -17,17 +19,8 @@ const BOUND_MARGIN: Real = 1e-9;
 /// Uniform grid of square cells over a point set.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PointGrid {
-    /// Lower-left corner of cell (0, 0), m.
-    origin: Vec2,
-    /// Cell edge length, m.
-    cell: Real,
-    /// Number of cells along x and y.
-    nx: usize,
-    ny: usize,
-    /// Cell `c = iy * nx + ix` holds `items[start[c]..start[c + 1]]`.
-    start: Vec<u32>,
-    /// Point indices sorted by cell, ascending index within a cell.
-    items: Vec<u32>,
+    /// Point indices by cell, ascending index within a cell.
+    cells: CellGrid,
     /// The points, in their original order.
     points: Vec<Vec2>,
 }
@@ -35,7 +28,8 @@ pub struct PointGrid {
 impl PointGrid {
     /// Build a grid with cells of (at least) `cell` metres. The cell is
     /// enlarged if the bounding box would need more than `4 n + 64` cells,
-    /// so memory stays linear in the number of points.
+    /// so memory stays linear in the number of points
+    /// ([`CellLayout::capped_cell`]).
     ///
     /// Returns `None` if `cell` is not positive and finite or a point is not
     /// finite (callers validate their inputs first and map this to their own
@@ -44,50 +38,10 @@ impl PointGrid {
         if !(cell.is_finite() && cell > 0.0) || points.iter().any(|p| !p.iter().all(|c| c.is_finite())) {
             return None;
         }
-        let (mut lo, mut hi) = (Vec2::zeros(), Vec2::zeros());
-        if let Some(first) = points.first() {
-            lo = *first;
-            hi = *first;
-        }
-        for p in points {
-            lo = lo.inf(p);
-            hi = hi.sup(p);
-        }
-        let ext = hi - lo;
-        let max_cells = (4 * points.len() + 64) as Real;
-        let mut cell = cell;
-        loop {
-            let cells = ((ext.x / cell).floor() + 1.0) * ((ext.y / cell).floor() + 1.0);
-            if cells <= max_cells {
-                break;
-            }
-            cell *= 2.0;
-        }
-        let nx = (ext.x / cell).floor() as usize + 1;
-        let ny = (ext.y / cell).floor() as usize + 1;
-        let mut grid = Self {
-            origin: lo,
-            cell,
-            nx,
-            ny,
-            start: vec![0; nx * ny + 1],
-            items: vec![0; points.len()],
-            points: points.to_vec(),
-        };
-        for p in points {
-            let c = grid.cell_of(p);
-            grid.start[c + 1] += 1;
-        }
-        for c in 0..nx * ny {
-            grid.start[c + 1] += grid.start[c];
-        }
-        let mut fill = grid.start.clone();
-        for (i, p) in points.iter().enumerate() {
-            let c = grid.cell_of(p);
-            grid.items[fill[c] as usize] = i as u32;
-            fill[c] += 1;
-        }
-        Some(grid)
+        let (lo, hi) = bounding_box(points);
+        let cell = CellLayout::capped_cell(hi - lo, cell, points.len());
+        let cells = CellGrid::of_points(CellLayout::new(lo, hi, cell), points);
+        Some(Self { cells, points: points.to_vec() })
     }
 
     /// Number of points.
@@ -107,36 +61,7 @@ impl PointGrid {
 
     /// Cell edge length actually used, m.
     pub fn cell_size(&self) -> Real {
-        self.cell
-    }
-
-    /// Cell coordinates of `p`, clamped to the grid.
-    #[inline]
-    fn cell_coords(&self, p: &Vec2) -> (usize, usize) {
-        let fx = ((p.x - self.origin.x) / self.cell).floor();
-        let fy = ((p.y - self.origin.y) / self.cell).floor();
-        // `as usize` saturates (and maps NaN to 0): no panic on any input.
-        let ix = fx.clamp(0.0, (self.nx - 1) as Real) as usize;
-        let iy = fy.clamp(0.0, (self.ny - 1) as Real) as usize;
-        (ix, iy)
-    }
-
-    #[inline]
-    fn cell_of(&self, p: &Vec2) -> usize {
-        let (ix, iy) = self.cell_coords(p);
-        iy * self.nx + ix
-    }
-
-    /// Visit every point of the cells in the inclusive box `[x0, x1] × [y0, y1]`.
-    #[inline]
-    fn visit_box(&self, x0: usize, x1: usize, y0: usize, y1: usize, mut f: impl FnMut(usize)) {
-        for iy in y0..=y1 {
-            let row = iy * self.nx;
-            let (a, b) = (self.start[row + x0] as usize, self.start[row + x1 + 1] as usize);
-            for &i in &self.items[a..b] {
-                f(i as usize);
-            }
-        }
+        self.cells.layout().cell_size()
     }
 
     /// The nearest point to `p` and its squared distance; among points at
@@ -150,7 +75,10 @@ impl PointGrid {
         if self.points.is_empty() {
             return None;
         }
-        let (cx, cy) = self.cell_coords(p);
+        let layout = self.cells.layout();
+        let (nx, ny) = layout.dims();
+        let (origin, c) = (layout.origin(), layout.cell_size());
+        let (cx, cy) = layout.cell_coords(p);
         let mut best: Option<(usize, Real)> = None;
         let consider = |i: usize, best: &mut Option<(usize, Real)>| {
             let d2 = (self.points[i] - p).norm_squared();
@@ -159,45 +87,47 @@ impl PointGrid {
                 _ => *best = Some((i, d2)),
             }
         };
+        let visit_box = |x0, x1, y0, y1, best: &mut Option<(usize, Real)>| {
+            self.cells.for_each_in(CellRange { x0, x1, y0, y1 }, |i| consider(i, best))
+        };
         let mut k = 0usize;
         loop {
             // Ring k: cells at Chebyshev distance exactly k from (cx, cy).
             let x0 = cx.saturating_sub(k);
-            let x1 = (cx + k).min(self.nx - 1);
+            let x1 = (cx + k).min(nx - 1);
             let y0 = cy.saturating_sub(k);
-            let y1 = (cy + k).min(self.ny - 1);
+            let y1 = (cy + k).min(ny - 1);
             if k == 0 {
-                self.visit_box(cx, cx, cy, cy, |i| consider(i, &mut best));
+                visit_box(cx, cx, cy, cy, &mut best);
             } else {
                 if cy >= k {
-                    self.visit_box(x0, x1, cy - k, cy - k, |i| consider(i, &mut best));
+                    visit_box(x0, x1, cy - k, cy - k, &mut best);
                 }
-                if cy + k < self.ny {
-                    self.visit_box(x0, x1, cy + k, cy + k, |i| consider(i, &mut best));
+                if cy + k < ny {
+                    visit_box(x0, x1, cy + k, cy + k, &mut best);
                 }
-                let (ry0, ry1) = (cy.saturating_sub(k - 1), (cy + k - 1).min(self.ny - 1));
+                let (ry0, ry1) = (cy.saturating_sub(k - 1), (cy + k - 1).min(ny - 1));
                 if cx >= k {
-                    self.visit_box(cx - k, cx - k, ry0, ry1, |i| consider(i, &mut best));
+                    visit_box(cx - k, cx - k, ry0, ry1, &mut best);
                 }
-                if cx + k < self.nx {
-                    self.visit_box(cx + k, cx + k, ry0, ry1, |i| consider(i, &mut best));
+                if cx + k < nx {
+                    visit_box(cx + k, cx + k, ry0, ry1, &mut best);
                 }
             }
             // Lower bound of the distance from p to any cell outside the
             // visited box, over the faces that have not reached the grid edge.
             let mut bound = Real::INFINITY;
-            let c = self.cell;
             if x0 > 0 {
-                bound = bound.min(p.x - (self.origin.x + x0 as Real * c));
+                bound = bound.min(p.x - (origin.x + x0 as Real * c));
             }
-            if x1 + 1 < self.nx {
-                bound = bound.min(self.origin.x + (x1 + 1) as Real * c - p.x);
+            if x1 + 1 < nx {
+                bound = bound.min(origin.x + (x1 + 1) as Real * c - p.x);
             }
             if y0 > 0 {
-                bound = bound.min(p.y - (self.origin.y + y0 as Real * c));
+                bound = bound.min(p.y - (origin.y + y0 as Real * c));
             }
-            if y1 + 1 < self.ny {
-                bound = bound.min(self.origin.y + (y1 + 1) as Real * c - p.y);
+            if y1 + 1 < ny {
+                bound = bound.min(origin.y + (y1 + 1) as Real * c - p.y);
             }
             if bound == Real::INFINITY {
                 return best; // every cell visited
@@ -218,10 +148,9 @@ impl PointGrid {
         if self.points.is_empty() || r.is_nan() || r <= 0.0 {
             return;
         }
-        let (x0, y0) = self.cell_coords(&Vec2::new(p.x - r, p.y - r));
-        let (x1, y1) = self.cell_coords(&Vec2::new(p.x + r, p.y + r));
+        let range = self.cells.layout().cells_of_box(&Vec2::new(p.x - r, p.y - r), &Vec2::new(p.x + r, p.y + r));
         let r2 = r * r;
-        self.visit_box(x0, x1, y0, y1, |i| {
+        self.cells.for_each_in(range, |i| {
             let d2 = (self.points[i] - p).norm_squared();
             if d2 < r2 {
                 f(i, d2);
@@ -309,7 +238,8 @@ mod tests {
         // a huge cell request on a tiny set, and a tiny cell on a wide set
         let pts = [Vec2::new(0.0, 0.0), Vec2::new(1e6, 1e6)];
         let g = PointGrid::new(&pts, 1e-9).unwrap();
-        assert!(g.nx * g.ny <= 4 * 2 + 64);
+        let (nx, ny) = g.cells.layout().dims();
+        assert!(nx * ny <= 4 * 2 + 64);
         assert_eq!(g.nearest(&Vec2::new(2e6, 2e6)), Some((1, 2e12)));
     }
 }

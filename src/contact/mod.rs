@@ -9,7 +9,8 @@
 //!   ogival).
 //! - [`surface`]: geometric detection of surface particles, the initial
 //!   slave set; [`slave`]: the slave set and its pairing cache.
-//! - [`grid`]: the uniform cell grid of the coarse search;
+//! - [`grid`]: the point grid of the coarse search (nearest point, fixed
+//!   radius) over [`crate::neighbors::CellGrid`];
 //!   [`search`]: nearest vertex → segment (or vertex) → signed gap.
 //! - [`force`]: one-step normal force, Coulomb friction, spreading weights.
 //! - [`deformable`]: deformable masters (the bodies' boundaries and crack
