@@ -24,6 +24,11 @@
 //!   to the perforating points ([`fit_recht_ipson`]), `v_bl` kept inside the
 //!   bracket.
 //!
+//! - **Resolutions** ([`at_rows`], [`Rung`]): the same study at several
+//!   particle spacings, a uniform refinement of every deformable body, and
+//!   the table of the limit and the residuals across them with their spread
+//!   ([`ladder_table`]; "converged or it doesn't count").
+//!
 //! Runs go side by side on threads of their own, each with its own pool of
 //! worker threads (the solver's results do not depend on the thread count).
 //! The table is rewritten after every finished run, so an interrupt keeps
@@ -136,6 +141,51 @@ pub fn flight(case: &Case, projectile: usize) -> (Vec2, Real) {
     let v = case.rigid_bodies[projectile].velocity;
     let v = Vec2::new(v[0], v[1]);
     (crate::residual::flight_direction(v), v.norm())
+}
+
+/// `case` refined uniformly so that its first deformable body has `rows`
+/// particle rows through its thickness: every deformable body's `layers`
+/// is multiplied by `k = rows / layers₀` (`layers₀` the first body's), its
+/// `fine_spacing` and `coarse_spacing` (where given) divided by `k`;
+/// nothing else changes (the fine zone's width and the grading ratio are
+/// geometry, `fracture.nonlocal_radius` and `band_width` material lengths,
+/// the time step follows the spacing). Each body's new row count must be a
+/// whole number of at least 2. Returns the case and the `--set` overrides
+/// that give it from the original (for the report and to rerun one rung):
+/// at `k = 2` a built-in coarse Børvik case becomes its fine sibling.
+pub fn at_rows(case: &Case, rows: usize) -> Result<(Case, Vec<String>), BallisticError> {
+    let first = case
+        .bodies
+        .first()
+        .ok_or_else(|| BallisticError::Settings("the case has no deformable body to refine".into()))?;
+    if rows < 2 {
+        return Err(BallisticError::Settings(format!("--rows: at least 2 rows through the thickness, got {rows}")));
+    }
+    let k = rows as Real / first.rectangle.layers as Real;
+    let mut c = case.clone();
+    let mut set = Vec::new();
+    for b in &mut c.bodies {
+        let r = &mut b.rectangle;
+        let layers = r.layers as Real * k;
+        if (layers - layers.round()).abs() > 1e-9 || layers.round() < 2.0 {
+            return Err(BallisticError::Settings(format!(
+                "--rows {rows}: body '{}' has {} rows where '{}' has {}, so it would get {layers:.3} (not a whole number of at least 2)",
+                b.name, r.layers, first.name, first.rectangle.layers
+            )));
+        }
+        if k == 1.0 {
+            continue;
+        }
+        r.layers = layers.round() as usize;
+        set.push(format!("bodies.{}.rectangle.layers={}", b.name, r.layers));
+        for (key, value) in [("fine_spacing", &mut r.fine_spacing), ("coarse_spacing", &mut r.coarse_spacing)] {
+            if let Some(h) = value {
+                *h /= k;
+                set.push(format!("bodies.{}.rectangle.{key}={h:e}", b.name));
+            }
+        }
+    }
+    Ok((c, set))
 }
 
 /// `case` with the projectile at `speed` m/s along its flight direction,
@@ -645,7 +695,7 @@ pub fn table(study: &Study) -> (String, String) {
     }
     for (v, e) in &study.failures {
         md.push_str(&format!(
-            "| {v:.2} | — | failed: {} | | | | | | |\n",
+            "| {v:.2} | — | failed: {} | | | | | | | |\n",
             e.lines().next().unwrap_or("").replace('|', "/")
         ));
     }
@@ -720,20 +770,19 @@ pub fn report(header: &str, study: &Study) -> String {
     s
 }
 
+/// Points drawn apart: a lone point between non-finite ones is a dot.
+fn dots(points: impl Iterator<Item = (Real, Real)>) -> Vec<(Real, Real)> {
+    points.flat_map(|q| [q, (Real::NAN, Real::NAN)]).collect()
+}
+
 /// The `v_r(v_i)` plot: the runs as points, the fit as a curve, the
 /// experimental points if any.
 pub fn plot(study: &Study, title: &str, experiments: &[(Real, Real)]) -> LinePlot {
-    // Points apart: a lone point between non-finite ones is drawn as a dot.
-    let dots =
-        |p: &mut dyn Iterator<Item = (Real, Real)>| p.flat_map(|q| [q, (Real::NAN, Real::NAN)]).collect::<Vec<_>>();
     let mut series = vec![Series {
         name: "simulated".into(),
         // Runs counted held (stopped, or undecided without a plug) at 0.
         points: dots(
-            &mut study
-                .shots
-                .iter()
-                .filter_map(|s| s.residual().or((!s.perforated()).then_some(0.0)).map(|v| (s.speed, v))),
+            study.shots.iter().filter_map(|s| s.residual().or((!s.perforated()).then_some(0.0)).map(|v| (s.speed, v))),
         ),
     }];
     if let Some(f) = &study.fit {
@@ -751,7 +800,7 @@ pub fn plot(study: &Study, title: &str, experiments: &[(Real, Real)]) -> LinePlo
         });
     }
     if !experiments.is_empty() {
-        series.push(Series { name: "experiments".into(), points: dots(&mut experiments.iter().copied()) });
+        series.push(Series { name: "experiments".into(), points: dots(experiments.iter().copied()) });
     }
     LinePlot {
         title: title.to_string(),
@@ -760,6 +809,155 @@ pub fn plot(study: &Study, title: &str, experiments: &[(Real, Real)]) -> LinePlo
         series,
         hlines: vec![],
     }
+}
+
+/// One resolution of a study at several ([`at_rows`]).
+#[derive(Clone, Debug)]
+pub struct Rung {
+    /// Particle rows through the first deformable body's thickness.
+    pub rows: usize,
+    /// Particle spacing through that thickness, m.
+    pub spacing: Real,
+    /// The `--set` overrides that give this resolution.
+    pub overrides: Vec<String>,
+    pub study: Study,
+}
+
+/// `(max − min) / mean` of `values` (`None` for fewer than two).
+pub fn spread(values: &[Real]) -> Option<Real> {
+    if values.len() < 2 {
+        return None;
+    }
+    let (lo, hi) = values.iter().fold((Real::MAX, Real::MIN), |(a, b), &x| (a.min(x), b.max(x)));
+    Some((hi - lo) / (values.iter().sum::<Real>() / values.len() as Real))
+}
+
+/// The resolutions side by side, as (Markdown, CSV): per rung the ballistic
+/// limit, the Recht–Ipson fit and the residual velocity at each of
+/// `speeds`, then the spread of each across the rungs ([`spread`]); the
+/// limit's spread counts only bracketed limits, a residual's only if every
+/// rung perforated at that speed (a held run is 0 m/s, which no spread
+/// describes: the Markdown says "held").
+pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
+    let mut md = String::from("| rows | spacing (mm) | v_bl (m/s) | Recht–Ipson a, p, v_bl |");
+    let mut csv = String::from("rows,spacing_mm,v_bl_m_s,v_bl_half_width_m_s,a,p,fit_v_bl_m_s");
+    for v in speeds {
+        md.push_str(&format!(" v_r at {v:.1} m/s |"));
+        csv.push_str(&format!(",v_r_at_{v:.1}"));
+    }
+    md.push_str(" runs | wall (s) |\n|---|---|---|---|");
+    md.push_str(&"---|".repeat(speeds.len() + 2));
+    md.push('\n');
+    csv.push_str(",runs,wall_s\n");
+    let residual_at = |st: &Study, v: Real| st.shots.iter().find(|s| s.speed == v).and_then(|s| s.residual());
+    for r in rungs {
+        let st = &r.study;
+        let limit = st.limit.as_ref().and_then(|l| l.estimate());
+        let wall: Real = st.shots.iter().map(|s| s.wall).sum();
+        md.push_str(&format!(
+            "| {} | {:.3} | {} | {} |",
+            r.rows,
+            r.spacing * 1e3,
+            limit.map_or("—".into(), |(v, h)| format!("{v:.2} ± {h:.2}")),
+            st.fit.map_or("—".into(), |f| format!("{:.3}, {:.2}, {:.2}", f.a, f.p, f.v_bl)),
+        ));
+        csv.push_str(&format!(
+            "{},{:.6},{},{},{},{},{}",
+            r.rows,
+            r.spacing * 1e3,
+            limit.map_or(String::new(), |l| format!("{:.3}", l.0)),
+            limit.map_or(String::new(), |l| format!("{:.3}", l.1)),
+            st.fit.map_or(String::new(), |f| format!("{:.5}", f.a)),
+            st.fit.map_or(String::new(), |f| format!("{:.4}", f.p)),
+            st.fit.map_or(String::new(), |f| format!("{:.3}", f.v_bl)),
+        ));
+        for &v in speeds {
+            let vr = residual_at(st, v);
+            md.push_str(&match vr {
+                Some(x) if x > 0.0 => format!(" {x:.2} |"),
+                Some(_) => " held |".into(),
+                None => " — |".into(),
+            });
+            csv.push_str(&format!(",{}", vr.map_or(String::new(), |x| format!("{x:.3}"))));
+        }
+        md.push_str(&format!(" {} | {wall:.0} |\n", st.shots.len()));
+        csv.push_str(&format!(",{},{wall:.2}\n", st.shots.len()));
+    }
+    let pct = |s: Option<Real>| s.map_or("—".into(), |x| format!("{:.1} %", 100.0 * x));
+    let limits: Vec<Real> =
+        rungs.iter().filter_map(|r| r.study.limit.as_ref().and_then(|l| l.estimate()).map(|e| e.0)).collect();
+    md.push_str(&format!(
+        "| spread | | {} | |",
+        if limits.len() == rungs.len() { pct(spread(&limits)) } else { "—".into() }
+    ));
+    for &v in speeds {
+        let vr: Option<Vec<Real>> = rungs.iter().map(|r| residual_at(&r.study, v).filter(|&x| x > 0.0)).collect();
+        md.push_str(&format!(" {} |", pct(vr.and_then(|x| spread(&x)))));
+    }
+    md.push_str(" | |\n");
+    (md, csv)
+}
+
+/// The resolutions' curves on one plot: each rung's runs as points (held
+/// runs at 0) and its Recht–Ipson curve, the experimental points if any.
+pub fn ladder_plot(rungs: &[Rung], title: &str, experiments: &[(Real, Real)]) -> LinePlot {
+    let mut p = LinePlot {
+        title: title.to_string(),
+        x_label: "impact velocity v_i (m/s)".into(),
+        y_label: "residual velocity v_r (m/s)".into(),
+        ..LinePlot::default()
+    };
+    // One series (one colour) per rung: its points, then its curve after a
+    // break.
+    for r in rungs {
+        let one = plot(&r.study, "", &[]);
+        let mut points = Vec::new();
+        for s in &one.series {
+            points.extend(s.points.iter().copied().chain([(Real::NAN, Real::NAN)]));
+        }
+        let name = match &r.study.fit {
+            Some(f) => format!("{} rows: Recht-Ipson a = {:.3}, p = {:.2}, v_bl = {:.1} m/s", r.rows, f.a, f.p, f.v_bl),
+            None => format!("{} rows", r.rows),
+        };
+        p.series.push(Series { name, points });
+    }
+    if !experiments.is_empty() {
+        p.series.push(Series { name: "experiments".into(), points: dots(experiments.iter().copied()) });
+    }
+    p
+}
+
+/// Write `convergence.md`, `convergence.csv` and `convergence.png` into
+/// `dir`: the resolutions side by side ([`ladder_table`], [`ladder_plot`]).
+pub fn write_ladder_files(
+    dir: &Path,
+    header: &str,
+    title: &str,
+    rungs: &[Rung],
+    speeds: &[Real],
+    experiments: &[(Real, Real)],
+) -> Result<Vec<PathBuf>, BallisticError> {
+    let (md, csv) = ladder_table(rungs, speeds);
+    let mut text = format!("# Ballistic study at {} resolutions\n\n{header}\n\n{md}\n", rungs.len());
+    text.push_str(
+        "Spread: (max − min) / mean over the resolutions. Each resolution's own table, report and plot are in \
+         `rows-N/` (its `--set` overrides in its header).\n\n",
+    );
+    for r in rungs {
+        let set = if r.overrides.is_empty() { "the case as given".to_string() } else { r.overrides.join(" ") };
+        text.push_str(&format!("- {} rows: {set}\n", r.rows));
+    }
+    text.push_str("\n![v_r against v_i at each resolution](convergence.png)\n");
+    let write = |name: &str, t: String| -> Result<PathBuf, BallisticError> {
+        let path = dir.join(name);
+        std::fs::write(&path, t).map_err(|source| IoError::Write { path: path.clone(), source })?;
+        Ok(path)
+    };
+    let mut files = vec![write("convergence.csv", csv)?, write("convergence.md", text)?];
+    let png = dir.join("convergence.png");
+    crate::io::save_line_plot(&png, &ladder_plot(rungs, title, experiments))?;
+    files.push(png);
+    Ok(files)
 }
 
 /// Write `ballistic.csv`, `ballistic.md` and `ballistic.png` into `dir`.
@@ -880,5 +1078,69 @@ mod tests {
         std::fs::write(&path, "v_i,v_r\n200,x\n").unwrap();
         assert!(read_experiments(&path).unwrap_err().to_string().contains("line 2"));
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    fn builtin(name: &str, set: &[String]) -> Case {
+        Case::from_str_with(crate::cases::builtin_case(name).unwrap(), name, set).unwrap()
+    }
+
+    /// Doubling the rows of the coarse Børvik case gives its fine sibling
+    /// (an independent case file), and the overrides reported give the same
+    /// case again.
+    #[test]
+    fn twice_the_rows_is_the_fine_case_file() {
+        let coarse = builtin("borvik-1-axisymmetric-nonlocal", &[]);
+        let (fine, set) = at_rows(&coarse, 48).unwrap();
+        assert_eq!(fine.bodies, builtin("borvik-1-axisymmetric-fine-nonlocal", &[]).bodies);
+        assert_eq!(fine.bodies, builtin("borvik-1-axisymmetric-nonlocal", &set).bodies);
+        assert_eq!(
+            (fine.rigid_bodies, fine.fracture, fine.time),
+            (coarse.rigid_bodies.clone(), coarse.fracture, coarse.time.clone())
+        );
+        let (same, none) = at_rows(&coarse, 24).unwrap();
+        assert!(none.is_empty() && same.bodies == coarse.bodies);
+        let (half, _) = at_rows(&coarse, 12).unwrap();
+        assert_eq!(half.bodies[0].rectangle.layers, 12);
+        assert_eq!(half.bodies[0].rectangle.coarse_spacing, Some(1.2e-3));
+    }
+
+    /// Every body is refined by the same factor: a row count that leaves
+    /// another body a fraction of a row is refused, naming it.
+    #[test]
+    fn a_refinement_must_give_every_body_whole_rows() {
+        let two = builtin("two-plates-axisymmetric", &[]);
+        let (both, _) = at_rows(&two, 26).unwrap();
+        assert_eq!((both.bodies[0].rectangle.layers, both.bodies[1].rectangle.layers), (26, 22));
+        let e = at_rows(&two, 20).unwrap_err().to_string();
+        assert!(e.contains(&format!("'{}'", two.bodies[1].name)) && e.contains("whole number"), "{e}");
+        assert!(at_rows(&two, 1).unwrap_err().to_string().contains("at least 2"));
+    }
+
+    #[test]
+    fn the_ladder_table_gives_the_spread_of_limits_and_residuals() {
+        let perf = |v| Verdict::Perforated { residual: v, since: 0.0 };
+        let held = Verdict::Held { since: 0.0 };
+        let rung = |rows: usize, (lo, hi): (Real, Real), at_200: Verdict, at_300: Real| Rung {
+            rows,
+            spacing: 0.012 / rows as Real,
+            overrides: Vec::new(),
+            study: Study {
+                shots: vec![shot(200.0, at_200), shot(300.0, perf(at_300))],
+                limit: Some(Limit { held: Some(lo), perforated: Some(hi), tol: 1.0, non_monotonic: None }),
+                ..Study::default()
+            },
+        };
+        let rungs = [rung(12, (119.0, 121.0), perf(100.0), 250.0), rung(24, (129.0, 131.0), perf(110.0), 250.0)];
+        let (md, csv) = ladder_table(&rungs, &[200.0, 300.0]);
+        // limits 120 and 130: 10/125 = 8.0 %; at 200 m/s 100 and 110: 10/105 = 9.5 %; at 300 m/s 0 %
+        let last = md.lines().last().unwrap();
+        assert!(last.contains("| 8.0 % |") && last.contains("| 9.5 % |") && last.contains("| 0.0 % |"), "{md}");
+        assert!(md.contains("| 12 | 1.000 | 120.00 ± 1.00 |"), "{md}");
+        assert_eq!(csv.lines().count(), 3, "{csv}");
+        assert!(csv.lines().nth(2).unwrap().starts_with("24,0.500000,130.000,1.000,,,,110.000,250.000,2,"), "{csv}");
+        // A held run has no residual to compare: "held", and no spread at that speed.
+        let rungs = [rung(12, (119.0, 121.0), held, 250.0), rung(24, (129.0, 131.0), perf(110.0), 250.0)];
+        let (md, _) = ladder_table(&rungs, &[200.0]);
+        assert!(md.contains("| held |") && md.lines().last().unwrap().contains("| 8.0 % | | — |"), "{md}");
     }
 }

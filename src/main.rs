@@ -127,6 +127,13 @@ enum Command {
         /// Experimental points to plot: a CSV with header v_i,v_r (m/s).
         #[arg(long)]
         experiments: Option<PathBuf>,
+        /// Run the whole study at each of these resolutions: particle rows
+        /// through the first deformable body's thickness (comma-separated,
+        /// e.g. 12,24,48; every deformable body refined by the same factor),
+        /// each into rows-N/, and write convergence.md/.csv/.png with the
+        /// limit and the residuals side by side and their spread.
+        #[arg(long, value_delimiter = ',')]
+        rows: Vec<usize>,
     },
     /// Benchmark fixed workloads: shape functions, material kernel, force
     /// assembly, whole steps (1 and all threads), optionally whole cases.
@@ -257,9 +264,23 @@ fn list_cases() -> Result<()> {
 fn dispatch(cmd: Command) -> Result<()> {
     match cmd {
         Command::Cases => list_cases(),
-        Command::Ballistic { case_file, case, speeds, limit, lo, hi, tol, projectile, jobs, set, out, experiments } => {
+        Command::Ballistic {
+            case_file,
+            case,
+            speeds,
+            limit,
+            lo,
+            hi,
+            tol,
+            projectile,
+            jobs,
+            set,
+            out,
+            experiments,
+            rows,
+        } => {
             let (case, name, file) = load(&case_file, &case, &set)?;
-            let args = BallisticArgs { speeds, limit, lo, hi, tol, projectile, jobs, experiments };
+            let args = BallisticArgs { speeds, limit, lo, hi, tol, projectile, jobs, experiments, rows };
             ballistic(case, &name, &file, &set, out, args)
         }
         Command::Bench { case, steps, whole, set } => bench(&case, steps, whole, &set),
@@ -537,6 +558,7 @@ struct BallisticArgs {
     projectile: Option<String>,
     jobs: Option<usize>,
     experiments: Option<PathBuf>,
+    rows: Vec<usize>,
 }
 
 fn ballistic(
@@ -547,8 +569,7 @@ fn ballistic(
     out: Option<PathBuf>,
     args: BallisticArgs,
 ) -> Result<()> {
-    use plugsim::ballistic::{find_limit, flight, read_experiments, run_speeds, select_projectile, write_files};
-    use plugsim::ballistic::{Event, Setup, Study};
+    use plugsim::ballistic::{at_rows, read_experiments, select_projectile, write_ladder_files, Rung};
     let projectile = select_projectile(&case, file, args.projectile.as_deref())?;
     if args.speeds.is_empty() && !args.limit {
         bail!("give --speeds V1,V2,... and/or --limit");
@@ -556,16 +577,86 @@ fn ballistic(
     if let Some(v) = args.speeds.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
         bail!("impact speeds must be positive numbers (got {v})");
     }
+    // Every resolution is checked before the first run starts.
+    let resolutions = args.rows.iter().map(|&r| Ok((r, at_rows(&case, r)?))).collect::<Result<Vec<_>>>()?;
     let experiments = match &args.experiments {
         Some(p) => read_experiments(p)?,
         None => Vec::new(),
     };
+    let out_dir = out.unwrap_or_else(|| Path::new("runs").join(format!("ballistic-{name}")));
+    let interrupt = install_interrupt_handler();
+    let started = Instant::now();
+    if resolutions.is_empty() {
+        let study = one_study(case, file, set, projectile, &out_dir, &args, &experiments, &interrupt, started)?;
+        return finish(&study);
+    }
+    let mut rungs = Vec::new();
+    for (rows, (refined, extra)) in resolutions {
+        let body = &refined.bodies[0].rectangle;
+        let spacing = (body.y_max - body.y_min) / rows as f64;
+        let dir = out_dir.join(format!("rows-{rows}"));
+        eprintln!(
+            "plugsim ballistic: {rows} rows ({:.3} mm){}",
+            spacing * 1e3,
+            if extra.is_empty() { String::new() } else { format!(": {}", extra.join(" ")) }
+        );
+        let all: Vec<String> = set.iter().chain(&extra).cloned().collect();
+        let study = one_study(refined, file, &all, projectile, &dir, &args, &experiments, &interrupt, started)?;
+        let stop = study.interrupted;
+        rungs.push(Rung { rows, spacing, overrides: extra, study });
+        if stop {
+            break;
+        }
+    }
+    let header = format!(
+        "Case {file}{}, produced by `plugsim ballistic --rows` ({} {}) on {}; total wall time {:.0} s.",
+        if set.is_empty() { String::new() } else { format!(" with {}", set.join(" ")) },
+        env!("CARGO_PKG_VERSION"),
+        env!("PLUGSIM_COMMIT"),
+        cpu_name(),
+        started.elapsed().as_secs_f64()
+    );
+    let title = format!("{}: v_r against v_i at {} resolutions", case.title, rungs.len());
+    let files = write_ladder_files(&out_dir, &header, &title, &rungs, &args.speeds, &experiments)?;
+    println!("{}", plugsim::ballistic::ladder_table(&rungs, &args.speeds).0);
+    for f in files {
+        println!("written: {}", f.display());
+    }
+    match rungs.last() {
+        Some(r) if r.study.interrupted => finish(&r.study),
+        _ => Ok(()),
+    }
+}
+
+/// Stop with an error if the study was interrupted.
+fn finish(study: &plugsim::ballistic::Study) -> Result<()> {
+    if study.interrupted {
+        bail!("interrupted: the table keeps the {} runs finished before it", study.shots.len());
+    }
+    Ok(())
+}
+
+/// One ballistic study of `case` (the speeds, then the limit if asked) into
+/// `out_dir`: its table, report and plot, printed and written.
+#[allow(clippy::too_many_arguments)]
+fn one_study(
+    case: Case,
+    file: &str,
+    set: &[String],
+    projectile: usize,
+    out_dir: &Path,
+    args: &BallisticArgs,
+    experiments: &[(f64, f64)],
+    interrupt: &Option<Arc<AtomicBool>>,
+    started: Instant,
+) -> Result<plugsim::ballistic::Study> {
+    use plugsim::ballistic::{find_limit, flight, run_speeds, write_files};
+    use plugsim::ballistic::{Event, Setup, Study};
     let (_, impact) = flight(&case, projectile);
     let cores = rayon::current_num_threads().max(1);
     let jobs = args.jobs.unwrap_or(cores).max(1);
     let threads_per_run = (cores / jobs).max(1);
-    let out_dir = out.unwrap_or_else(|| Path::new("runs").join(format!("ballistic-{name}")));
-    std::fs::create_dir_all(&out_dir).with_context(|| format!("cannot create {}", out_dir.display()))?;
+    std::fs::create_dir_all(out_dir).with_context(|| format!("cannot create {}", out_dir.display()))?;
     let setup = Setup {
         case,
         label: file.to_string(),
@@ -573,8 +664,8 @@ fn ballistic(
         projectile,
         jobs,
         threads_per_run,
-        out_dir: out_dir.clone(),
-        interrupt: install_interrupt_handler(),
+        out_dir: out_dir.to_path_buf(),
+        interrupt: interrupt.clone(),
     };
     let body = &setup.case.rigid_bodies[projectile].name;
     let header = format!(
@@ -586,8 +677,8 @@ fn ballistic(
         cpu_name()
     );
     let title = format!("{}: residual against impact velocity", setup.case.title);
-    let mut report = |study: &Study| write_files(&out_dir, &header, &title, study, &experiments).map(|_| ());
-    let started = Instant::now();
+    let mut report = |study: &Study| write_files(out_dir, &header, &title, study, experiments).map(|_| ());
+    let study_started = Instant::now();
     let mut progress = |e: Event| {
         let at = started.elapsed().as_secs_f64();
         match e {
@@ -620,16 +711,13 @@ fn ballistic(
         let bounds = (args.lo.unwrap_or(0.5 * impact), args.hi.unwrap_or(impact));
         find_limit(&setup, bounds, args.tol, &mut study, &mut report, &mut progress)?;
     }
-    let files = write_files(&out_dir, &header, &title, &study, &experiments)?;
+    let files = write_files(out_dir, &header, &title, &study, experiments)?;
     println!("{}", plugsim::ballistic::report(&header, &study));
-    println!("total wall time {:.1} s", started.elapsed().as_secs_f64());
+    println!("total wall time {:.1} s", study_started.elapsed().as_secs_f64());
     for f in files {
         println!("written: {}", f.display());
     }
-    if study.interrupted {
-        bail!("interrupted: the table keeps the {} runs finished before it", study.shots.len());
-    }
-    Ok(())
+    Ok(study)
 }
 
 /// The CPU's model name from `/proc/cpuinfo`, for the provenance lines of

@@ -143,3 +143,42 @@ fn an_interrupt_keeps_the_finished_runs() {
     assert_eq!(study.shots.len(), 1);
     std::fs::remove_dir_all(&s.out_dir).ok();
 }
+
+/// `plugsim ballistic --rows`: the whole study at each resolution, each in
+/// its own directory, and the table side by side; a resolution that cannot
+/// be made is refused before any run starts.
+#[test]
+fn the_command_runs_the_study_at_each_resolution() {
+    let dir = std::env::temp_dir().join(format!("plugsim-ballistic-rows-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let case = dir.join("small.toml");
+    std::fs::write(&case, small_plate()).unwrap();
+    let plugsim = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_plugsim"))
+            .args(["--threads", "1", "ballistic", case.to_str().unwrap()])
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let out = dir.join("out");
+    let o = plugsim(&["--rows", "5,9", "--speeds", "500", "--out", out.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    for rows in [5, 9] {
+        let md = std::fs::read_to_string(out.join(format!("rows-{rows}/ballistic.md"))).unwrap();
+        assert!(md.contains("| 500.00 |"), "{md}");
+    }
+    let md = std::fs::read_to_string(out.join("convergence.md")).unwrap();
+    assert!(md.contains("| 5 | 0.800 |") && md.contains("| 9 | 0.444 |") && md.contains("| spread |"), "{md}");
+    assert!(md.contains("bodies.plate.rectangle.layers=5"), "{md}");
+    assert_eq!(std::fs::read_to_string(out.join("convergence.csv")).unwrap().lines().count(), 3);
+    assert!(out.join("convergence.png").exists());
+    // 1 row is no plate: refused, nothing run.
+    let bad = dir.join("bad");
+    let o = plugsim(&["--rows", "9,1", "--speeds", "500", "--out", bad.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && stderr.contains("at least 2"), "{stderr}");
+    assert!(!bad.exists(), "refused before any run");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
