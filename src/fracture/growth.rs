@@ -783,17 +783,26 @@ impl CrackGrowth {
         });
         let damage = tip_damage(model, j, value);
         let split = Split { parent: i, vertex: xi, incoming: d, outgoing: d, reach: (xj - xi).norm(), offset };
-        let (l, r) = self.split(model, id, split)?;
-        self.cracks[id].vertices[0].faces = Some((l as u32, r as u32));
-        self.events.push(CrackEvent {
-            time,
-            step,
-            crack: id,
-            kind: EventKind::Nucleate,
-            particles: vec![l, r, j],
-            value,
-            damage,
-        });
+        let event = CrackEvent { time, step, crack: id, kind: EventKind::Nucleate, particles: vec![j], value, damage };
+        self.split_logged(model, 0, split, event)
+    }
+
+    /// Split `split.parent` for crack `event.crack`, give the crack's vertex
+    /// `vertex` the two children as its faces, and log `event` with the
+    /// children first in its particle list (left, right, then the new tip
+    /// if any). Returns the children.
+    fn split_logged(
+        &mut self,
+        model: &mut Model,
+        vertex: usize,
+        split: Split,
+        mut event: CrackEvent,
+    ) -> Result<Vec<usize>, FractureError> {
+        let c = event.crack;
+        let (l, r) = self.split(model, c, split)?;
+        self.cracks[c].vertices[vertex].faces = Some((l as u32, r as u32));
+        event.particles.splice(0..0, [l, r]);
+        self.events.push(event);
         Ok(vec![l, r])
     }
 
@@ -824,18 +833,8 @@ impl CrackGrowth {
             reach: last_len.min((xj - xt).norm()),
             offset: self.cracks[c].offset,
         };
-        let (l, r) = self.split(model, c, split)?;
-        self.cracks[c].vertices[n - 1].faces = Some((l as u32, r as u32));
-        self.events.push(CrackEvent {
-            time,
-            step,
-            crack: c,
-            kind: EventKind::Propagate,
-            particles: vec![l, r, j],
-            value,
-            damage,
-        });
-        Ok(vec![l, r])
+        let event = CrackEvent { time, step, crack: c, kind: EventKind::Propagate, particles: vec![j], value, damage };
+        self.split_logged(model, n - 1, split, event)
     }
 
     /// Arrest: split the tip in halves, extend the path by δ, stop.
@@ -852,18 +851,8 @@ impl CrackGrowth {
         self.cracks[c].tip = None;
         self.cracks[c].arrested = Some((time, step));
         let split = Split { parent: tip, vertex: xt, incoming: d, outgoing: d, reach: last_len, offset };
-        let (l, r) = self.split(model, c, split)?;
-        self.cracks[c].vertices[n - 1].faces = Some((l as u32, r as u32));
-        self.events.push(CrackEvent {
-            time,
-            step,
-            crack: c,
-            kind: EventKind::Arrest,
-            particles: vec![l, r],
-            value,
-            damage,
-        });
-        Ok(vec![l, r])
+        let event = CrackEvent { time, step, crack: c, kind: EventKind::Arrest, particles: Vec::new(), value, damage };
+        self.split_logged(model, n - 1, split, event)
     }
 
     /// Split a particle at a crack vertex and rebuild what the change
