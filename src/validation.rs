@@ -265,17 +265,17 @@ pub fn convergence_rows() -> Vec<Row> {
 }
 
 /// The row and the overrides of `coarse`'s ladder at `layers` rows
-/// ([`LADDER`]): its fine sibling at 48.
+/// ([`LADDER`]): its fine sibling at 48, else the coarse case refined by
+/// [`crate::ballistic::at_rows`] (the refinement of `plugsim ballistic
+/// --rows`, which at 48 rows gives the fine case file).
 pub fn rung(coarse: &Row, layers: usize) -> (Row, Vec<String>) {
     match layers {
         48 => (Row::of(BorvikCase { discretization: "fine", ..coarse.case }), Vec::new()),
-        24 => (coarse.clone(), Vec::new()),
         n => {
-            let spacing = 0.6e-3 * 24.0 / n as Real;
-            let set = vec![
-                format!("bodies.plate.rectangle.layers={n}"),
-                format!("bodies.plate.rectangle.coarse_spacing={spacing:e}"),
-            ];
+            let text = builtin_case(&coarse.id).expect("validation rows name built-in cases");
+            let case = Case::from_str_with(text, &coarse.id, &[]).expect("built-in cases parse");
+            let (_, set) =
+                crate::ballistic::at_rows(&case, n).expect("the ladder's row counts refine the coarse plate");
             (coarse.clone(), set)
         }
     }
@@ -289,8 +289,7 @@ pub type Ladder = (Row, Vec<Outcome>);
 /// rung perforated.
 pub fn residual_spread(outcomes: &[Outcome]) -> Option<Real> {
     let v: Vec<Real> = outcomes.iter().map(|o| o.residual().filter(|&r| r > 0.0)).collect::<Option<_>>()?;
-    let (lo, hi) = v.iter().fold((Real::MAX, Real::MIN), |(a, b), &x| (a.min(x), b.max(x)));
-    Some((hi - lo) / (v.iter().sum::<Real>() / v.len() as Real))
+    crate::ballistic::spread(&v)
 }
 
 /// The convergence table as Markdown and CSV: per ladder, the residual
