@@ -948,14 +948,26 @@ pub fn write_ladder_files(
         text.push_str(&format!("- {} rows: {set}\n", r.rows));
     }
     text.push_str("\n![v_r against v_i at each resolution](convergence.png)\n");
-    let write = |name: &str, t: String| -> Result<PathBuf, BallisticError> {
-        let path = dir.join(name);
-        std::fs::write(&path, t).map_err(|source| IoError::Write { path: path.clone(), source })?;
-        Ok(path)
-    };
-    let mut files = vec![write("convergence.csv", csv)?, write("convergence.md", text)?];
-    let png = dir.join("convergence.png");
-    crate::io::save_line_plot(&png, &ladder_plot(rungs, title, experiments))?;
+    write_report(dir, "convergence", csv, text, &ladder_plot(rungs, title, experiments))
+}
+
+/// Write `STEM.csv`, `STEM.md` and `STEM.png` (the plot) into `dir`;
+/// returns their paths.
+fn write_report(
+    dir: &Path,
+    stem: &str,
+    csv: String,
+    md: String,
+    plot: &LinePlot,
+) -> Result<Vec<PathBuf>, BallisticError> {
+    let mut files = Vec::new();
+    for (ext, text) in [("csv", csv), ("md", md)] {
+        let path = dir.join(format!("{stem}.{ext}"));
+        std::fs::write(&path, text).map_err(|source| IoError::Write { path: path.clone(), source })?;
+        files.push(path);
+    }
+    let png = dir.join(format!("{stem}.png"));
+    crate::io::save_line_plot(&png, plot)?;
     files.push(png);
     Ok(files)
 }
@@ -969,16 +981,7 @@ pub fn write_files(
     experiments: &[(Real, Real)],
 ) -> Result<Vec<PathBuf>, BallisticError> {
     let (_, csv) = table(study);
-    let write = |name: &str, text: String| -> Result<PathBuf, BallisticError> {
-        let path = dir.join(name);
-        std::fs::write(&path, text).map_err(|source| IoError::Write { path: path.clone(), source })?;
-        Ok(path)
-    };
-    let mut files = vec![write("ballistic.csv", csv)?, write("ballistic.md", report(header, study))?];
-    let png = dir.join("ballistic.png");
-    crate::io::save_line_plot(&png, &plot(study, title, experiments))?;
-    files.push(png);
-    Ok(files)
+    write_report(dir, "ballistic", csv, report(header, study), &plot(study, title, experiments))
 }
 
 #[cfg(test)]

@@ -59,7 +59,7 @@ pub fn nodal_mass(model: &Model, i: usize) -> Real {
 /// `Σ_q N_i(X_q) w_q c_q / Σ_q N_i(X_q) w_q` (0 without points).
 /// [`CrackEvent::damage`] of particle `i`: its lumped damage, NaN for an
 /// inserted pre-crack (whose `value` is NaN: no criterion decided it).
-fn tip_damage(model: &Model, i: usize, value: Real) -> Real {
+fn own_damage(model: &Model, i: usize, value: Real) -> Real {
     if value.is_nan() {
         Real::NAN
     } else {
@@ -781,7 +781,7 @@ impl CrackGrowth {
             arrested: None,
             allowance: 0.0,
         });
-        let damage = tip_damage(model, j, value);
+        let damage = own_damage(model, j, value);
         let split = Split { parent: i, vertex: xi, incoming: d, outgoing: d, reach: (xj - xi).norm(), offset };
         let event = CrackEvent { time, step, crack: id, kind: EventKind::Nucleate, particles: vec![j], value, damage };
         self.split_logged(model, 0, split, event)
@@ -824,7 +824,7 @@ impl CrackGrowth {
         let last_len = (xt - self.cracks[c].vertices[n - 2].x0).norm();
         self.cracks[c].vertices.push(CrackVertex { x0: xj, faces: None });
         self.cracks[c].tip = Some(j);
-        let damage = tip_damage(model, j, value);
+        let damage = own_damage(model, j, value);
         let split = Split {
             parent: tip,
             vertex: xt,
@@ -841,7 +841,7 @@ impl CrackGrowth {
     fn arrest(&mut self, model: &mut Model, c: usize, time: Real, step: u64) -> Result<Vec<usize>, FractureError> {
         let tip = self.cracks[c].tip.expect("growing");
         let value = self.criterion_value(model, tip);
-        let damage = tip_damage(model, tip, value);
+        let damage = own_damage(model, tip, value);
         let xt = model.particles.x0[tip];
         let d = self.cracks[c].direction();
         let n = self.cracks[c].vertices.len();
