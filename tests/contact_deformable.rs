@@ -10,18 +10,16 @@ use plugsim::math::{Real, Vec2};
 use plugsim::run::build_simulation;
 use plugsim::step::Simulation;
 
+#[macro_use]
+mod common;
+
 /// Two free elastic steel blocks, 10 × 10 mm with 1 mm particles: `a`
 /// flies at `velocity` into `b` (at rest, 0.1 mm away, offset 2 mm up).
 fn two_blocks(velocity: [Real; 2], friction: Real) -> Case {
     let text = format!(
-        r#"
-[geometry]
-mode = "plane_strain"
-[materials.steel]
-model = "elastic"
-density = 7850.0
-youngs_modulus = 200.0e9
-poisson_ratio = 0.3
+        concat!(
+            elastic_steel_plane_strain!(),
+            r#"
 [[bodies]]
 name = "a"
 material = "steel"
@@ -33,11 +31,12 @@ name = "b"
 material = "steel"
 rectangle = {{ x_min = 0.0101, x_max = 0.0201, y_min = 0.002, y_max = 0.012, layers = 11 }}
 [contact]
-friction_coefficient = {friction}
+friction_coefficient = {}
 [time]
 end = 8.0e-6
-"#,
-        velocity[0], velocity[1]
+"#
+        ),
+        velocity[0], velocity[1], friction
     );
     Case::from_str_with(&text, "two-blocks.toml", &[]).unwrap().resolved()
 }
@@ -116,14 +115,9 @@ fn two_free_bodies_conserve_momentum_close_the_energy_balance_and_do_not_interpe
 fn friction_between_deformable_bodies_obeys_coulomb() {
     // a slides along b's top face while pressed onto it.
     let mu = 0.2;
-    let text = r#"
-[geometry]
-mode = "plane_strain"
-[materials.steel]
-model = "elastic"
-density = 7850.0
-youngs_modulus = 200.0e9
-poisson_ratio = 0.3
+    let text = concat!(
+        elastic_steel_plane_strain!(),
+        r#"
 [[bodies]]
 name = "a"
 material = "steel"
@@ -136,7 +130,8 @@ material = "steel"
 rectangle = { x_min = -0.01, x_max = 0.03, y_min = 0.0, y_max = 0.006, layers = 7 }
 [time]
 end = 4.0e-6
-"#;
+"#
+    );
     let run = |mu: Real| {
         let case = Case::from_str_with(text, "slide.toml", &[format!("contact.friction_coefficient={mu}")])
             .unwrap()
@@ -297,14 +292,9 @@ fn rod_on_rod_gives_the_final_length_of_rod_on_anvil() {
 /// whose facing crack faces are each other's masters. The +x piece moves
 /// at `-speed` along x, the other at `+speed`.
 fn cracked_block(speed: Real, self_contact: bool) -> Simulation {
-    let text = r#"
-[geometry]
-mode = "plane_strain"
-[materials.steel]
-model = "elastic"
-density = 7850.0
-youngs_modulus = 200.0e9
-poisson_ratio = 0.3
+    let text = concat!(
+        elastic_steel_plane_strain!(),
+        r#"
 [[bodies]]
 name = "block"
 material = "steel"
@@ -313,7 +303,8 @@ rectangle = { x_min = 0.0, x_max = 0.010, y_min = 0.0, y_max = 0.007, layers = 8
 criterion = "effective_strain"
 [time]
 end = 2.0e-6
-"#;
+"#
+    );
     let set = [format!("contact.self_contact={self_contact}")];
     let case = Case::from_str_with(text, "cracked.toml", &set).unwrap().resolved();
     let mut sim = build_simulation(&case).unwrap();
@@ -388,14 +379,9 @@ fn deformable_contact_measures_the_physical_points() {
     // does not reproduce (quadratic in x), so its generalized positions
     // X + U differ from its physical points X + Σ N U, and a velocity
     // toward b (pairs that start inside only resist going deeper).
-    let text = r#"
-[geometry]
-mode = "plane_strain"
-[materials.steel]
-model = "elastic"
-density = 7850.0
-youngs_modulus = 200.0e9
-poisson_ratio = 0.3
+    let text = concat!(
+        elastic_steel_plane_strain!(),
+        r#"
 [[bodies]]
 name = "a"
 material = "steel"
@@ -406,7 +392,8 @@ material = "steel"
 rectangle = { x_min = -0.002, x_max = 0.012, y_min = 0.0, y_max = 0.006, layers = 7 }
 [time]
 end = 1.0e-6
-"#;
+"#
+    );
     let case = Case::from_str_with(text, "touching.toml", &[]).unwrap().resolved();
     let mut sim = build_simulation(&case).unwrap();
     let p = &mut sim.model.particles;
@@ -471,14 +458,9 @@ fn crack_rows_stay_in_their_body() {
     // A block lying on a plate; a crack split into the plate from its top
     // face right under the block. The rebuilt rows of the plate must not
     // take in the block's particles (nor the block's rows the plate's).
-    let text = r#"
-[geometry]
-mode = "plane_strain"
-[materials.steel]
-model = "elastic"
-density = 7850.0
-youngs_modulus = 200.0e9
-poisson_ratio = 0.3
+    let text = concat!(
+        elastic_steel_plane_strain!(),
+        r#"
 [[bodies]]
 name = "plate"
 material = "steel"
@@ -491,7 +473,8 @@ rectangle = { x_min = 0.002, x_max = 0.008, y_min = 0.004, y_max = 0.007, layers
 criterion = "effective_strain"
 [time]
 end = 1.0e-6
-"#;
+"#
+    );
     let case = Case::from_str_with(text, "stacked.toml", &[]).unwrap().resolved();
     let mut sim = build_simulation(&case).unwrap();
     let x0 = sim.model.particles.x0.clone();

@@ -1,6 +1,7 @@
 //! Contact inside the real time loop (SPEC §8 with §4–§5): momentum,
 //! impenetrability and an elastic rebound, driven through `Simulation`.
 
+#[macro_use]
 mod common;
 use plugsim::case::Case;
 use plugsim::math::{Real, Vec2};
@@ -9,14 +10,9 @@ use plugsim::run::build_simulation;
 /// An elastic plate (unsupported) and a free rigid projectile: nothing
 /// outside acts on the pair, so the total momentum `Σ m V + M V_p` is
 /// conserved through impact and rebound.
-const FREE: &str = r#"
-[geometry]
-mode = "plane_strain"
-[materials.steel]
-model = "elastic"
-density = 7850.0
-youngs_modulus = 200.0e9
-poisson_ratio = 0.3
+const FREE: &str = concat!(
+    elastic_steel_plane_strain!(),
+    r#"
 [[bodies]]
 name = "plate"
 material = "steel"
@@ -33,7 +29,8 @@ density = 7850.0
 velocity = [0.0, -100.0]
 [time]
 end = 8.0e-6
-"#;
+"#
+);
 
 fn momentum(sim: &plugsim::step::Simulation) -> Vec2 {
     let c = sim.contact.as_ref().unwrap();
@@ -89,14 +86,9 @@ fn no_penetration_of_the_projectile_nose() {
 /// a few percent and that no energy is gained.
 #[test]
 fn elastic_block_rebounds_from_a_rigid_wall() {
-    let text = r#"
-[geometry]
-mode = "plane_strain"
-[materials.steel]
-model = "elastic"
-density = 7850.0
-youngs_modulus = 200.0e9
-poisson_ratio = 0.3
+    let text = concat!(
+        elastic_steel_plane_strain!(),
+        r#"
 [[bodies]]
 name = "block"
 material = "steel"
@@ -117,7 +109,8 @@ velocity = [0.0, 0.0]
 prescribed = true
 [time]
 end = 2.0e-5
-"#;
+"#
+    );
     let case = Case::from_str_with(text, "drop.toml", &[]).unwrap().resolved();
     let mut sim = build_simulation(&case).unwrap();
     let e0 = sim.energies.initial_kinetic;

@@ -6,6 +6,9 @@ use plugsim::cases::builtin_case;
 use plugsim::run::build_simulation;
 use plugsim::step::fastest_particle;
 
+#[macro_use]
+mod common;
+
 /// The coarse plane-strain Borvik Case I (the README's main case) for its
 /// first 6 µs: the cracks nucleate at the projectile's corners at ~2 µs
 /// and tear the surface particles beside the corners off the plate.
@@ -77,14 +80,9 @@ fn no_particle_leaves_faster_than_the_rear_face_doubling() {
 fn a_slave_moved_inside_the_projectile_by_a_crack_is_not_thrown_out() {
     use plugsim::math::{Real, Vec2};
     let v_i = 10.0;
-    let text = r#"
-[geometry]
-mode = "plane_strain"
-[materials.steel]
-model = "elastic"
-density = 7850.0
-youngs_modulus = 200.0e9
-poisson_ratio = 0.3
+    let text = concat!(
+        elastic_steel_plane_strain!(),
+        r#"
 [[bodies]]
 name = "plate"
 material = "steel"
@@ -98,7 +96,8 @@ velocity = [0.0, -10.0]
 criterion = "effective_strain"
 [time]
 end = 1.0e-6
-"#;
+"#
+    );
     let case = Case::from_str_with(text, "tent.toml", &[]).unwrap().resolved();
     let mut sim = build_simulation(&case).unwrap();
     let alpha = 0.1;

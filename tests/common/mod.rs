@@ -4,6 +4,24 @@ use plugsim::case::Case;
 use plugsim::discretize::RectangleGrid;
 use plugsim::math::Real;
 
+/// The head of the small elastic cases: `[geometry]` in plane strain and
+/// `[materials.steel]`, elastic steel (ρ = 7850 kg/m³, E = 200 GPa,
+/// ν = 0.3); a string literal, for `concat!` with the rest of a case.
+#[allow(unused_macros)] // not every test binary uses every helper
+macro_rules! elastic_steel_plane_strain {
+    () => {
+        "
+[geometry]
+mode = \"plane_strain\"
+[materials.steel]
+model = \"elastic\"
+density = 7850.0
+youngs_modulus = 200.0e9
+poisson_ratio = 0.3
+"
+    };
+}
+
 /// A 4 mm plate and a blunt 8 mm projectile at 400 m/s with cracks
 /// (`small_impact.toml`), 12 µs: the fracture and ballistic tests' impact.
 #[allow(dead_code)] // not every test binary uses every helper
