@@ -239,7 +239,7 @@ pub fn rotate(dir: &Path, keep: usize) -> Result<(), CheckpointError> {
     for (_, path) in &all[..excess] {
         std::fs::remove_file(path).map_err(|source| CheckpointError::Io { path: path.clone(), source })?;
     }
-    remove_temporaries(dir);
+    crate::io::remove_temporaries(dir);
     Ok(())
 }
 
@@ -250,19 +250,8 @@ pub fn remove_all(dir: &Path) -> Result<(), CheckpointError> {
     for (_, path) in list(dir) {
         std::fs::remove_file(&path).map_err(|source| CheckpointError::Io { path: path.clone(), source })?;
     }
-    remove_temporaries(dir);
+    crate::io::remove_temporaries(dir);
     Ok(())
-}
-
-fn remove_temporaries(dir: &Path) {
-    if let Ok(entries) = std::fs::read_dir(dir) {
-        for e in entries.flatten() {
-            let name = e.file_name().to_string_lossy().to_string();
-            if name.starts_with(".checkpoint-") && name.contains(".tmp") {
-                let _ = std::fs::remove_file(e.path());
-            }
-        }
-    }
 }
 
 /// Read the newest readable checkpoint of a run's output directory. A

@@ -124,7 +124,9 @@ struct PendingSnapshot {
 impl OutputWriter {
     /// Start the series `results.pvd` and `history.csv` in `dir` (which
     /// must exist); `rigid` names each rigid body with its initial velocity.
+    /// Temporary files a killed earlier run left in `dir` are removed.
     pub fn create(dir: &Path, fields: &[String], rigid: &[(String, Vec2)]) -> Result<Self, IoError> {
+        crate::io::remove_temporaries(dir);
         let rigid_names: Vec<String> = rigid.iter().map(|r| r.0.clone()).collect();
         let cols = history_columns(&rigid_names);
         let cols: Vec<&str> = cols.iter().map(|s| s.as_str()).collect();
@@ -183,6 +185,7 @@ impl OutputWriter {
             .collect();
         let series = PvdSeries::with_entries(&dir.join("results.pvd"), entries)?;
         let n = snapshot_times.len();
+        crate::io::remove_temporaries(dir);
         if let Ok(listing) = std::fs::read_dir(dir) {
             for e in listing.flatten() {
                 let name = e.file_name().to_string_lossy().to_string();

@@ -185,6 +185,34 @@ pub(crate) fn temporary_sibling(path: &Path, suffix: &str) -> std::io::Result<Pa
     Ok(path.with_file_name(tmp_name))
 }
 
+/// Whether `name` is one of [`temporary_sibling`]'s names: `.NAME.tmpP-N`
+/// (optionally with a suffix), P a process id and N a counter.
+fn is_temporary_name(name: &str) -> bool {
+    let Some(rest) = name.strip_prefix('.') else { return false };
+    rest.rmatch_indices(".tmp").any(|(at, _)| {
+        let tail = &rest[at + 4..];
+        let (pid, after) = tail.split_at(tail.find(|c: char| !c.is_ascii_digit()).unwrap_or(tail.len()));
+        let counter = after.strip_prefix('-').unwrap_or("");
+        let digits = counter.len() - counter.trim_start_matches(|c: char| c.is_ascii_digit()).len();
+        at > 0 && !pid.is_empty() && digits > 0
+    })
+}
+
+/// Removes from `dir` every temporary file a process killed inside
+/// [`write_atomically`] (or another writer using [`temporary_sibling`]) left
+/// behind. A resumed run calls it, so that its directory ends as an
+/// uninterrupted run's would. Best effort: a file that cannot be removed
+/// is left.
+pub(crate) fn remove_temporaries(dir: &Path) {
+    if let Ok(entries) = std::fs::read_dir(dir) {
+        for e in entries.flatten() {
+            if is_temporary_name(&e.file_name().to_string_lossy()) && e.path().is_file() {
+                let _ = std::fs::remove_file(e.path());
+            }
+        }
+    }
+}
+
 /// Shortest text that parses back to exactly `value`: plain decimals for
 /// moderate magnitudes, exponent notation otherwise (`1.5e-5`), `NaN`,
 /// `inf`, `-inf` for non-finite values.
@@ -332,6 +360,30 @@ mod tests {
         assert_eq!(entries.len(), 1, "temporary file left behind");
         write_atomically(&path, |w| w.write_all(b"new")).unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), b"new");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_killed_writers_temporaries_are_removed_and_nothing_else() {
+        let dir = std::env::temp_dir().join(format!("plugsim-io-temporaries-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let strays = [
+            temporary_sibling(&dir.join("results.pvd"), "").unwrap(),
+            temporary_sibling(&dir.join("energy.png"), ".png").unwrap(),
+            dir.join(".checkpoint-000000000001.ckpt.tmp1-0"),
+        ];
+        let kept = ["results.pvd", "history.csv", ".tmp1-0", ".x.tmp", ".x.tmpA-1", "y.tmp1-0", ".plot.tmp12-"];
+        for path in strays.iter().cloned().chain(kept.iter().map(|n| dir.join(n))) {
+            std::fs::write(path, b"x").unwrap();
+        }
+        remove_temporaries(&dir);
+        for stray in &strays {
+            assert!(!stray.exists(), "{} left", stray.display());
+        }
+        for name in kept {
+            assert!(dir.join(name).exists(), "{name} removed");
+        }
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
