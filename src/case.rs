@@ -478,6 +478,7 @@ pub const OUTPUT_FIELDS: &[&str] = &[
     "plastic_strain_rate",
     "temperature",
     "damage",
+    "adiabatic_hardening",
     "mass",
     "body",
     "flags",

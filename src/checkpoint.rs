@@ -130,8 +130,10 @@ pub const MAGIC: [u8; 8] = *b"PLUGCKPT";
 /// the adaptive stable step (`Simulation::stable`, `dt_previous`) and the
 /// deformable contact (its masters, persistent pairs and work, the
 /// `deformable` and `self_contact` switches; issue #20), version 8 the
-/// crack events' own damage ([`crate::fracture::CrackEvent::damage`]).
-pub const FORMAT_VERSION: u32 = 8;
+/// crack events' own damage ([`crate::fracture::CrackEvent::damage`]),
+/// version 9 their adiabatic hardening
+/// ([`crate::fracture::CrackEvent::hardening`]).
+pub const FORMAT_VERSION: u32 = 9;
 /// Subdirectory of a run's output directory that holds its checkpoints.
 pub const DIRECTORY: &str = "checkpoints";
 /// File name extension of a checkpoint.

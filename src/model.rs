@@ -499,6 +499,19 @@ impl Model {
         self.mode.deformation_gradient(&gu, &uq, &self.quad.x0[q], 1.0)
     }
 
+    /// Quadrature point `k`'s adiabatic hardening
+    /// ([`crate::material::johnson_cook::JohnsonCook::adiabatic_hardening`]
+    /// at its plastic strain, temperature, damage and plastic rate; ≤ 0
+    /// past the onset of adiabatic shear localization), NaN in an elastic
+    /// body, held at no less than −100: a melted or fully damaged point's
+    /// `−∞` would make every projection it enters `−∞`.
+    pub fn adiabatic_hardening(&self, k: usize) -> Real {
+        let q = &self.quad;
+        self.materials[q.body[k] as usize]
+            .adiabatic_hardening(q.eps_p[k], q.temperature[k], q.damage[k], q.eps_p_rate[k])
+            .map_or(Real::NAN, |h| h.max(-100.0))
+    }
+
     /// Lumped projection of a quadrature field onto the particles:
     /// `f_I = Σ_q N_I(X_q) w_q f_q / Σ_q N_I(X_q) w_q` (the same weights as
     /// the lumped mass).

@@ -68,9 +68,12 @@ pub const HISTORY_COLUMNS: &[&str] = &[
 /// split particle (left child), the new right child and, for nucleate and
 /// propagate, the new tip, separated by spaces; `value` is the criterion
 /// value of the new tip (of the split tip at arrest; empty for an inserted
-/// pre-crack) and `damage` that particle's own Johnson–Cook damage
-/// ([`crate::fracture::CrackEvent::damage`]; empty likewise).
-pub const CRACK_COLUMNS: &[&str] = &["time", "step", "crack", "kind", "particles", "value", "damage"];
+/// pre-crack), `damage` that particle's own Johnson–Cook damage
+/// ([`crate::fracture::CrackEvent::damage`]; empty likewise) and
+/// `hardening` its adiabatic hardening, ≤ 0 past the onset of shear
+/// localization ([`crate::fracture::CrackEvent::hardening`]; empty likewise
+/// and in an elastic body).
+pub const CRACK_COLUMNS: &[&str] = &["time", "step", "crack", "kind", "particles", "value", "damage", "hardening"];
 
 /// Per-rigid-body history column suffixes.
 pub const RIGID_COLUMNS: &[&str] = &["x", "y", "vx", "vy", "fx", "fy", "contacts", "f_axial"];
@@ -466,17 +469,18 @@ impl OutputWriter {
         for e in &cracks.events[self.crack_events_written..] {
             let ids: Vec<String> = e.particles.iter().map(|i| i.to_string()).collect();
             let num = |v: Real| if v.is_finite() { format!("{v:.6e}") } else { String::new() };
-            let (value, damage) = (num(e.value), num(e.damage));
+            let (value, damage, hardening) = (num(e.value), num(e.damage), num(e.hardening));
             writeln!(
                 f,
-                "{:.9e},{},{},{},{},{},{}",
+                "{:.9e},{},{},{},{},{},{},{}",
                 e.time,
                 e.step,
                 e.crack,
                 e.kind.name(),
                 ids.join(" "),
                 value,
-                damage
+                damage,
+                hardening
             )
             .map_err(err)?;
         }
@@ -547,8 +551,8 @@ fn v3(v: &Vec2) -> [f64; 3] {
 
 /// Per-point values projected together by [`particle_piece`]: the five
 /// entries of the Cauchy stress's block form (`xx, xy, yx, yy, zz`), then
-/// the four quadrature-point scalars a snapshot can carry.
-const PROJECTED: usize = 5 + 4;
+/// the five quadrature-point scalars a snapshot can carry.
+const PROJECTED: usize = 5 + 5;
 
 /// Several quadrature fields projected in one pass over the gather table
 /// ([`Model::project`] of a fixed-size row): each entry gets the same
@@ -599,11 +603,13 @@ pub fn particle_piece(model: &Model, fields: &[String]) -> VtuPiece {
         piece = piece.with_point_data(DataArray::vectors("velocity", &v.iter().map(v3).collect::<Vec<_>>()));
     }
     // The scalars' slots follow the stress's five in each projected row.
+    let hardening = if want("adiabatic_hardening") { adiabatic_hardening(model) } else { vec![0.0; q.len()] };
     let scalar_fields: [(&str, &[Real]); PROJECTED - 5] = [
         ("plastic_strain", &q.eps_p),
         ("plastic_strain_rate", &q.eps_p_rate),
         ("temperature", &q.temperature),
         ("damage", &q.damage),
+        ("adiabatic_hardening", &hardening),
     ];
     let stress_wanted = want("stress") || want("effective_stress") || want("pressure");
     if stress_wanted || scalar_fields.iter().any(|(f, _)| want(f)) {
@@ -657,6 +663,12 @@ pub fn particle_piece(model: &Model, fields: &[String]) -> VtuPiece {
         piece = piece.with_point_data(DataArray::integers("flags", p.flags.iter().map(|f| f.0 as i32).collect()));
     }
     piece
+}
+
+/// Every quadrature point's [`Model::adiabatic_hardening`], the output
+/// field `adiabatic_hardening`.
+pub fn adiabatic_hardening(model: &Model) -> Vec<Real> {
+    (0..model.quad.len()).into_par_iter().map(|k| model.adiabatic_hardening(k)).collect()
 }
 
 /// Plot the energy history of the run in `dir` (`energy.png`) from its

@@ -287,6 +287,7 @@ fn crack_state_round_trips_bit_for_bit() {
             particles: vec![k, 2 * k],
             value,
             damage: -value,
+            hardening: value,
         });
     }
     // Events must name an existing crack.
@@ -393,19 +394,19 @@ fn checkpoint_of_another_format_version_is_refused_naming_both() {
     }
 }
 
-/// Format 7 (postcard, before the crack events' own damage) is refused,
-/// naming both versions, rather than misread.
+/// Format 8 (postcard, before the crack events' adiabatic hardening) is
+/// refused, naming both versions, rather than misread.
 #[test]
 fn older_format_version_checkpoint_is_refused_naming_both_versions() {
-    assert_eq!(FORMAT_VERSION, 8);
+    assert_eq!(FORMAT_VERSION, 9);
     let case = case(STRIKE, &["time.end=1e-6"]);
-    let dir = scratch("version-7");
+    let dir = scratch("version-8");
     let path = run_until(&case, &dir, 2);
-    corrupt(&path, 8, &7u32.to_le_bytes());
+    corrupt(&path, 8, &8u32.to_le_bytes());
     let e = checkpoint::read(&path).unwrap_err().to_string();
-    assert!(e.contains("format version 7 ") && e.contains("reads format version 8"), "{e}");
+    assert!(e.contains("format version 8 ") && e.contains("reads format version 9"), "{e}");
     let e = resume(&config(&dir, None), &mut |_| {}).unwrap_err().to_string();
-    assert!(e.contains("format version 7 ") && e.contains("format version 8"), "{e}");
+    assert!(e.contains("format version 8 ") && e.contains("format version 9"), "{e}");
 }
 
 #[test]

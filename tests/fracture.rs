@@ -225,20 +225,32 @@ fn crack_events_record_the_tips_own_damage() {
     for e in &g.events {
         assert!((e.damage - 0.37).abs() < 1e-12, "{e:?}");
         assert!(e.value >= 0.3, "the effective strain decided: {e:?}");
+        assert!(e.hardening.is_nan(), "an elastic body has no flow stress to soften: {e:?}");
     }
     let summary = g.tip_damage().unwrap();
     let grown = g.events.iter().filter(|e| e.kind != EventKind::Arrest).count();
     assert_eq!(summary.count, grown);
     assert!((summary.min - 0.37).abs() < 1e-12 && (summary.max - 0.37).abs() < 1e-12, "{summary:?}");
+    // Weldox 460 E at a uniform plastic strain and temperature: every
+    // point's adiabatic hardening is the material's at that state (no
+    // damage coupling), and so is each tip's lumped value.
     let mut m = plate(nx, ny);
+    let weldox = plugsim::material::library::weldox_460e();
+    let (eps, temperature) = (0.5, 400.0);
+    let expected = weldox.adiabatic_hardening(eps, temperature, 0.0, 0.0);
+    assert!(expected > 0.0);
+    m.materials[0] = Material::JohnsonCook(weldox);
     for q in 0..m.quad.len() {
         m.quad.damage[q] = 2.0 * band(&m.quad.x0[q]);
+        m.quad.eps_p[q] = eps;
+        m.quad.temperature[q] = temperature;
     }
     let mut g = CrackGrowth::new(FractureParameters { critical_damage: 0.5, ..params(Criterion::Damage) });
     drive(&mut m, &mut g, 30);
     assert!(g.events.len() >= 4, "{:?}", g.events);
     for e in &g.events {
         assert!((e.damage - e.value).abs() <= 1e-12 * e.value.abs(), "{e:?}");
+        assert!((e.hardening - expected).abs() <= 1e-12 * expected, "{e:?} against {expected}");
     }
 }
 

@@ -575,3 +575,66 @@ fn open_fractured_material_does_not_push() {
     }
     assert!(s.tau.trace() / 3.0 < -1.0e9, "closed material squeezed by 1 % pushes back: {:.3e}", s.tau.trace() / 3.0);
 }
+
+// ---------------------------------------------------------------------------
+// Adiabatic hardening (the onset of adiabatic shear localization).
+// ---------------------------------------------------------------------------
+
+/// With `m = 1` and no rate sensitivity the adiabatic stress–strain curve
+/// has a closed form: `1 − T* = exp(−k (A ε̄ + B ε̄ⁿ⁺¹/(n+1)))`,
+/// `k = χ/(ρ₀ C_p (T_m − T₀))`, so `τ̄ = (A + B ε̄ⁿ)(1 − T*)` peaks where
+/// `B n ε̄ⁿ⁻¹ = k (A + B ε̄ⁿ)²`. The hardening vanishes there, on that
+/// curve, and is positive before and negative after.
+#[test]
+fn adiabatic_hardening_vanishes_at_the_peak_of_the_closed_form_adiabatic_curve() {
+    let m = JohnsonCook { softening_exponent: 1.0, rate_sensitivity: 0.0, ..weldox_460e() };
+    let (a, b, n) = (m.yield_stress, m.hardening_modulus, m.hardening_exponent);
+    let span = m.melting_temperature - m.room_temperature;
+    let k = m.taylor_quinney / (m.density * m.specific_heat * span);
+    let temperature =
+        |e: f64| m.room_temperature + span * (1.0 - (-k * (a * e + b * e.powf(n + 1.0) / (n + 1.0))).exp());
+    let excess = |e: f64| b * n * e.powf(n - 1.0) - k * (a + b * e.powf(n)).powi(2);
+    let (mut lo, mut hi) = (1e-3, 10.0);
+    assert!(excess(lo) > 0.0 && excess(hi) < 0.0);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if excess(mid) > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let peak = 0.5 * (lo + hi);
+    assert!(peak > 0.3 && peak < 3.0, "{peak}");
+    let h = |e: f64| m.adiabatic_hardening(e, temperature(e), 0.0, 1.0);
+    let scale = h(0.5 * peak);
+    assert!(scale > 0.0);
+    assert!(h(peak).abs() < 1e-9 * scale, "at the peak {}: {} (scale {scale})", peak, h(peak));
+    assert!(h(0.9 * peak) > 0.0 && h(1.1 * peak) < 0.0);
+    // The same through the material enum; an elastic material has none.
+    assert_eq!(Material::JohnsonCook(m.clone()).adiabatic_hardening(peak, temperature(peak), 0.0, 1.0), Some(h(peak)));
+    let elastic =
+        Elastic { density: 7850.0, youngs_modulus: 200e9, poisson_ratio: 0.3, room_temperature: 293.0, thermal: None };
+    assert_eq!(Material::Elastic(elastic).adiabatic_hardening(1.0, 293.0, 0.0, 1.0), None);
+}
+
+/// Weldox 460 E as it is (m = 0.94, rate-sensitive) in adiabatic simple
+/// shear at 10⁴ 1/s through the material-point driver: the hardening
+/// evaluated on the driver's states changes sign where the driver's
+/// stress–strain curve peaks (the elastic part and the slow change of the
+/// plastic rate make the two differ by a little).
+#[test]
+fn adiabatic_hardening_changes_sign_at_the_peak_of_the_driven_shear_curve() {
+    let m = weldox_460e();
+    let config =
+        DriverConfig { path: LoadPath::SimpleShear, rate: 1e4, final_strain: 4.0, dt: 2e-7, initial_temperature: None };
+    let records = run(&Material::JohnsonCook(m.clone()), &config).unwrap();
+    let peak = records.iter().max_by(|x, y| x.equivalent_stress.partial_cmp(&y.equivalent_stress).unwrap()).unwrap();
+    let onset = records
+        .iter()
+        .skip(1)
+        .find(|r| m.adiabatic_hardening(r.eps_p, r.temperature, r.damage, r.eps_p_rate) <= 0.0)
+        .expect("the point softens before gamma = 4");
+    assert!(peak.eps_p > 1.0 && peak.eps_p < 3.0, "peak at {}", peak.eps_p);
+    assert!((onset.eps_p - peak.eps_p).abs() < 0.005 * peak.eps_p, "onset at {}, peak at {}", onset.eps_p, peak.eps_p);
+}

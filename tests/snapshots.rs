@@ -41,12 +41,16 @@ fn fused_projection_has_the_bits_of_one_field_at_a_time() {
         ("plastic_strain_rate", &q.eps_p_rate),
         ("temperature", &q.temperature),
         ("damage", &q.damage),
+        ("adiabatic_hardening", &plugsim::output::adiabatic_hardening(m)),
     ] {
         assert_eq!(bits(array(&piece, name).iter().cloned()), bits(m.project(|k| col[k])), "{name}");
     }
     // The state is not trivial: the plate yields and heats under the projectile.
     assert!(array(&piece, "plastic_strain").iter().cloned().fold(0.0, f64::max) > 0.01);
     assert!(array(&piece, "effective_stress").iter().cloned().fold(0.0, f64::max) > 1e8);
+    // Hardening everywhere this early (the plate is far from its adiabatic
+    // instability): finite and positive at every particle.
+    assert!(array(&piece, "adiabatic_hardening").iter().all(|&h| h.is_finite() && h > 0.0));
 }
 
 #[test]

@@ -57,22 +57,26 @@ pub fn nodal_mass(model: &Model, i: usize) -> Real {
 
 /// The lumped projection of the quadrature values `col` at particle `i`,
 /// `Σ_q N_i(X_q) w_q c_q / Σ_q N_i(X_q) w_q` (0 without points).
-/// [`CrackEvent::damage`] of particle `i`: its lumped damage, NaN for an
-/// inserted pre-crack (whose `value` is NaN: no criterion decided it).
-fn own_damage(model: &Model, i: usize, value: Real) -> Real {
+/// [`CrackEvent::damage`] and [`CrackEvent::hardening`] of particle `i`:
+/// its lumped damage and adiabatic hardening, NaN for an inserted
+/// pre-crack (whose `value` is NaN: no criterion decided it).
+fn own_state(model: &Model, i: usize, value: Real) -> (Real, Real) {
     if value.is_nan() {
-        Real::NAN
+        (Real::NAN, Real::NAN)
     } else {
-        lumped_projection(model, i, &model.quad.damage)
+        (
+            lumped_projection(model, i, |q| model.quad.damage[q]),
+            lumped_projection(model, i, |q| model.adiabatic_hardening(q)),
+        )
     }
 }
 
-fn lumped_projection(model: &Model, i: usize, col: &[Real]) -> Real {
+fn lumped_projection(model: &Model, i: usize, value: impl Fn(usize) -> Real) -> Real {
     let (mut acc, mut wsum) = (0.0, 0.0);
     for j in model.gather.range(i) {
         let q = model.gather.point[j] as usize;
         let w = model.gather.value[j] * model.quad.weight[q];
-        acc += w * col[q];
+        acc += w * value(q);
         wsum += w;
     }
     if wsum != 0.0 {
@@ -130,6 +134,12 @@ pub struct CrackEvent {
     /// shows whether the crack runs through a band (`D` well above the
     /// average) or through diffuse material (`D ≈ D̄`, far below 1).
     pub damage: Real,
+    /// The deciding particle's adiabatic hardening `(1/τ̄) dτ̄/dε̄`
+    /// (lumped projection of [`crate::model::Model::adiabatic_hardening`]):
+    /// ≤ 0 where the material has passed the onset of adiabatic shear
+    /// localization, positive where the crack enters material that still
+    /// hardens. NaN for an inserted pre-crack and in an elastic body.
+    pub hardening: Real,
 }
 
 /// Summary of the own damage of the particles the cracks grew into
@@ -383,7 +393,7 @@ impl CrackGrowth {
             Criterion::NonlocalDamage => return self.nonlocal_damage(model, i),
             Criterion::None => return 0.0,
         };
-        lumped_projection(model, i, col)
+        lumped_projection(model, i, |q| col[q])
     }
 
     /// Johnson–Cook damage of particle `i` averaged over the material
@@ -407,7 +417,7 @@ impl CrackGrowth {
         if self.params.criterion != Criterion::NonlocalDamage {
             return value;
         }
-        lumped_projection(model, i, &model.quad.damage)
+        lumped_projection(model, i, |q| model.quad.damage[q])
     }
 
     /// Stress triaxiality `σ_m / σ_eq` at particle `i`: the ratio of the
@@ -781,9 +791,18 @@ impl CrackGrowth {
             arrested: None,
             allowance: 0.0,
         });
-        let damage = own_damage(model, j, value);
+        let (damage, hardening) = own_state(model, j, value);
         let split = Split { parent: i, vertex: xi, incoming: d, outgoing: d, reach: (xj - xi).norm(), offset };
-        let event = CrackEvent { time, step, crack: id, kind: EventKind::Nucleate, particles: vec![j], value, damage };
+        let event = CrackEvent {
+            time,
+            step,
+            crack: id,
+            kind: EventKind::Nucleate,
+            particles: vec![j],
+            value,
+            damage,
+            hardening,
+        };
         self.split_logged(model, 0, split, event)
     }
 
@@ -824,7 +843,7 @@ impl CrackGrowth {
         let last_len = (xt - self.cracks[c].vertices[n - 2].x0).norm();
         self.cracks[c].vertices.push(CrackVertex { x0: xj, faces: None });
         self.cracks[c].tip = Some(j);
-        let damage = own_damage(model, j, value);
+        let (damage, hardening) = own_state(model, j, value);
         let split = Split {
             parent: tip,
             vertex: xt,
@@ -833,7 +852,16 @@ impl CrackGrowth {
             reach: last_len.min((xj - xt).norm()),
             offset: self.cracks[c].offset,
         };
-        let event = CrackEvent { time, step, crack: c, kind: EventKind::Propagate, particles: vec![j], value, damage };
+        let event = CrackEvent {
+            time,
+            step,
+            crack: c,
+            kind: EventKind::Propagate,
+            particles: vec![j],
+            value,
+            damage,
+            hardening,
+        };
         self.split_logged(model, n - 1, split, event)
     }
 
@@ -841,7 +869,7 @@ impl CrackGrowth {
     fn arrest(&mut self, model: &mut Model, c: usize, time: Real, step: u64) -> Result<Vec<usize>, FractureError> {
         let tip = self.cracks[c].tip.expect("growing");
         let value = self.criterion_value(model, tip);
-        let damage = own_damage(model, tip, value);
+        let (damage, hardening) = own_state(model, tip, value);
         let xt = model.particles.x0[tip];
         let d = self.cracks[c].direction();
         let n = self.cracks[c].vertices.len();
@@ -851,7 +879,16 @@ impl CrackGrowth {
         self.cracks[c].tip = None;
         self.cracks[c].arrested = Some((time, step));
         let split = Split { parent: tip, vertex: xt, incoming: d, outgoing: d, reach: last_len, offset };
-        let event = CrackEvent { time, step, crack: c, kind: EventKind::Arrest, particles: Vec::new(), value, damage };
+        let event = CrackEvent {
+            time,
+            step,
+            crack: c,
+            kind: EventKind::Arrest,
+            particles: Vec::new(),
+            value,
+            damage,
+            hardening,
+        };
         self.split_logged(model, n - 1, split, event)
     }
 

@@ -520,6 +520,30 @@ impl JohnsonCook {
         3.0 * self.shear_modulus() + tau_bar * fs.g_eps / fs.g + heat * tau_bar * tau_bar * fs.g_temp / fs.g
     }
 
+    /// Adiabatic hardening at a constant plastic rate, `(1/τ̄) dτ̄/dε̄`
+    /// (dimensionless): the slope of the flow stress `τ̄ = R(ε̄̇) g` when the
+    /// plastic work heats the point where it is done (`dT = χ τ̄ dε̄/(ρ₀ C_p)`),
+    ///
+    /// `(1/τ̄) dτ̄/dε̄ = (g_ε + g_T χ τ̄/(ρ₀ C_p))/g = (H − 3G)/τ̄`,
+    ///
+    /// with `H` the update's [`JohnsonCook::tangent_modulus`] (one place for
+    /// the equation) and `R ≥ 1` the rate factor at `rate`. Where it is
+    /// ≤ 0 thermal softening has overtaken strain hardening: Recht's (1964)
+    /// condition for catastrophic thermoplastic shear, the onset of
+    /// adiabatic shear localization in its simplest form (no delay by the
+    /// rate sensitivity or by conduction, so an early bound). At `g ≤ 0`
+    /// (melted or fully damaged and coupled) the point carries no shear:
+    /// `−∞`. A diagnostic (output field `adiabatic_hardening`); no crack
+    /// criterion reads it. Test: `adiabatic_hardening_vanishes_at_the_peak_of_the_adiabatic_curve`.
+    pub fn adiabatic_hardening(&self, eps_p: Real, temperature: Real, damage: Real, rate: Real) -> Real {
+        let fs = self.flow_stress_slopes(eps_p, temperature, damage);
+        if fs.g <= 0.0 {
+            return Real::NEG_INFINITY;
+        }
+        let tau_bar = self.rate_factor(rate).max(1.0) * fs.g;
+        (self.tangent_modulus(tau_bar, &fs) - 3.0 * self.shear_modulus()) / tau_bar
+    }
+
     /// `χ/(ρ₀ C_p)`, K/Pa: temperature rise per unit plastic work.
     pub fn heating_coefficient(&self) -> Real {
         self.taylor_quinney / (self.density * self.specific_heat)

@@ -176,6 +176,18 @@ impl Material {
     }
 }
 
+impl Material {
+    /// [`JohnsonCook::adiabatic_hardening`] of a point in this material at
+    /// plastic strain `eps_p`, `temperature`, `damage` and plastic rate
+    /// `rate`; `None` for an elastic material (no flow stress).
+    pub fn adiabatic_hardening(&self, eps_p: Real, temperature: Real, damage: Real, rate: Real) -> Option<Real> {
+        match self {
+            Material::Elastic(_) => None,
+            Material::JohnsonCook(m) => Some(m.adiabatic_hardening(eps_p, temperature, damage, rate)),
+        }
+    }
+}
+
 impl Constitutive for Material {
     #[inline]
     fn update(&self, old: &PointState, k: &StepKinematics) -> PointState {
