@@ -57,18 +57,30 @@ pub fn nodal_mass(model: &Model, i: usize) -> Real {
 
 /// The lumped projection of the quadrature values `col` at particle `i`,
 /// `Σ_q N_i(X_q) w_q c_q / Σ_q N_i(X_q) w_q` (0 without points).
-/// [`CrackEvent::damage`] and [`CrackEvent::hardening`] of particle `i`:
-/// its lumped damage and adiabatic hardening, NaN for an inserted
-/// pre-crack (whose `value` is NaN: no criterion decided it).
-fn own_state(model: &Model, i: usize, value: Real) -> (Real, Real) {
-    if value.is_nan() {
+/// The event of `kind` at `(time, step)` on `crack`, decided by particle
+/// `decider` with criterion value `value`: its particle list holds the new
+/// tip for nucleation and propagation (the split's children are put in
+/// front by [`CrackGrowth::split_logged`]), and it records the decider's
+/// lumped damage and adiabatic hardening, NaN for an inserted pre-crack
+/// (whose `value` is NaN: no criterion decided it).
+fn logged_event(
+    model: &Model,
+    at: (Real, u64),
+    crack: usize,
+    kind: EventKind,
+    decider: usize,
+    value: Real,
+) -> CrackEvent {
+    let (damage, hardening) = if value.is_nan() {
         (Real::NAN, Real::NAN)
     } else {
         (
-            lumped_projection(model, i, |q| model.quad.damage[q]),
-            lumped_projection(model, i, |q| model.adiabatic_hardening(q)),
+            lumped_projection(model, decider, |q| model.quad.damage[q]),
+            lumped_projection(model, decider, |q| model.adiabatic_hardening(q)),
         )
-    }
+    };
+    let particles = if kind == EventKind::Arrest { Vec::new() } else { vec![decider] };
+    CrackEvent { time: at.0, step: at.1, crack, kind, particles, value, damage, hardening }
 }
 
 fn lumped_projection(model: &Model, i: usize, value: impl Fn(usize) -> Real) -> Real {
@@ -791,18 +803,8 @@ impl CrackGrowth {
             arrested: None,
             allowance: 0.0,
         });
-        let (damage, hardening) = own_state(model, j, value);
         let split = Split { parent: i, vertex: xi, incoming: d, outgoing: d, reach: (xj - xi).norm(), offset };
-        let event = CrackEvent {
-            time,
-            step,
-            crack: id,
-            kind: EventKind::Nucleate,
-            particles: vec![j],
-            value,
-            damage,
-            hardening,
-        };
+        let event = logged_event(model, (time, step), id, EventKind::Nucleate, j, value);
         self.split_logged(model, 0, split, event)
     }
 
@@ -843,7 +845,6 @@ impl CrackGrowth {
         let last_len = (xt - self.cracks[c].vertices[n - 2].x0).norm();
         self.cracks[c].vertices.push(CrackVertex { x0: xj, faces: None });
         self.cracks[c].tip = Some(j);
-        let (damage, hardening) = own_state(model, j, value);
         let split = Split {
             parent: tip,
             vertex: xt,
@@ -852,16 +853,7 @@ impl CrackGrowth {
             reach: last_len.min((xj - xt).norm()),
             offset: self.cracks[c].offset,
         };
-        let event = CrackEvent {
-            time,
-            step,
-            crack: c,
-            kind: EventKind::Propagate,
-            particles: vec![j],
-            value,
-            damage,
-            hardening,
-        };
+        let event = logged_event(model, (time, step), c, EventKind::Propagate, j, value);
         self.split_logged(model, n - 1, split, event)
     }
 
@@ -869,7 +861,7 @@ impl CrackGrowth {
     fn arrest(&mut self, model: &mut Model, c: usize, time: Real, step: u64) -> Result<Vec<usize>, FractureError> {
         let tip = self.cracks[c].tip.expect("growing");
         let value = self.criterion_value(model, tip);
-        let (damage, hardening) = own_state(model, tip, value);
+        let event = logged_event(model, (time, step), c, EventKind::Arrest, tip, value);
         let xt = model.particles.x0[tip];
         let d = self.cracks[c].direction();
         let n = self.cracks[c].vertices.len();
@@ -879,16 +871,6 @@ impl CrackGrowth {
         self.cracks[c].tip = None;
         self.cracks[c].arrested = Some((time, step));
         let split = Split { parent: tip, vertex: xt, incoming: d, outgoing: d, reach: last_len, offset };
-        let event = CrackEvent {
-            time,
-            step,
-            crack: c,
-            kind: EventKind::Arrest,
-            particles: Vec::new(),
-            value,
-            damage,
-            hardening,
-        };
         self.split_logged(model, n - 1, split, event)
     }
 
