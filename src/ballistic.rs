@@ -216,6 +216,10 @@ pub struct Shot {
     /// Median own damage of the particles the cracks grew into
     /// ([`crate::fracture::CrackGrowth::tip_damage`]; the locus is 1).
     pub tip_damage: Option<Real>,
+    /// Least adiabatic hardening of the particles the cracks grew into
+    /// ([`crate::fracture::CrackGrowth::tip_hardening`]; ≤ 0: some tip
+    /// entered material past the onset of shear localization).
+    pub tip_hardening: Option<Real>,
     pub steps: u64,
     /// Wall time, s.
     pub wall: Real,
@@ -511,6 +515,7 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
                     end_time: s.time,
                     fastest: s.fastest.speed,
                     tip_damage: s.tip_damage.map(|d| d.median),
+                    tip_hardening: s.tip_hardening.map(|h| h.min),
                     steps: s.steps,
                     wall: t.elapsed().as_secs_f64(),
                     dir,
@@ -658,9 +663,9 @@ pub fn read_experiments(path: &Path) -> Result<Vec<(Real, Real)>, BallisticError
 
 /// The table as (Markdown, CSV).
 pub fn table(study: &Study) -> (String, String) {
-    let mut md = String::from("| v_i (m/s) | v_r (m/s) | outcome | perforation (us) | plug mass (kg; kg/m in plane strain) | end (us) | fastest particle (m/s) | crack-tip damage (median) | steps | wall (s) |\n|---|---|---|---|---|---|---|---|---|---|\n");
+    let mut md = String::from("| v_i (m/s) | v_r (m/s) | outcome | perforation (us) | plug mass (kg; kg/m in plane strain) | end (us) | fastest particle (m/s) | crack-tip damage (median) | crack-tip hardening (least) | steps | wall (s) |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
     let mut csv = String::from(
-        "v_i_m_s,v_r_m_s,perforated,outcome,perforation_us,plug_mass,end_us,fastest_particle_m_s,tip_damage_median,steps,wall_s,dir\n",
+        "v_i_m_s,v_r_m_s,perforated,outcome,perforation_us,plug_mass,end_us,fastest_particle_m_s,tip_damage_median,tip_hardening_min,steps,wall_s,dir\n",
     );
     let opt = |v: Option<Real>, f: &dyn Fn(Real) -> String| v.map_or_else(String::new, f);
     for s in &study.shots {
@@ -668,8 +673,9 @@ pub fn table(study: &Study) -> (String, String) {
         let perf = opt(s.perforation, &|t| format!("{:.2}", t * 1e6));
         let mass = opt(s.plug_mass, &|m| format!("{m:.5}"));
         let tip = opt(s.tip_damage, &|d| format!("{d:.3}"));
+        let hardening = opt(s.tip_hardening, &|h| format!("{h:.3}"));
         md.push_str(&format!(
-            "| {:.2} | {} | {} | {} | {} | {:.1} | {:.0} | {} | {} | {:.1} |\n",
+            "| {:.2} | {} | {} | {} | {} | {:.1} | {:.0} | {} | {} | {} | {:.1} |\n",
             s.speed,
             if vr.is_empty() { "—".into() } else { vr.clone() },
             s.outcome(),
@@ -678,11 +684,12 @@ pub fn table(study: &Study) -> (String, String) {
             s.end_time * 1e6,
             s.fastest,
             if tip.is_empty() { "—".into() } else { tip.clone() },
+            if hardening.is_empty() { "—".into() } else { hardening.clone() },
             s.steps,
             s.wall
         ));
         csv.push_str(&format!(
-            "{:.2},{vr},{},{},{perf},{mass},{:.3},{:.1},{tip},{},{:.2},{}\n",
+            "{:.2},{vr},{},{},{perf},{mass},{:.3},{:.1},{tip},{hardening},{},{:.2},{}\n",
             s.speed,
             s.perforated(),
             s.outcome().replace(',', ";"),
@@ -695,7 +702,7 @@ pub fn table(study: &Study) -> (String, String) {
     }
     for (v, e) in &study.failures {
         md.push_str(&format!(
-            "| {v:.2} | — | failed: {} | | | | | | | |\n",
+            "| {v:.2} | — | failed: {} | | | | | | | | |\n",
             e.lines().next().unwrap_or("").replace('|', "/")
         ));
     }
@@ -1032,6 +1039,7 @@ mod tests {
             end_time: 0.0,
             fastest: 0.0,
             tip_damage: None,
+            tip_hardening: None,
             steps: 0,
             wall: 0.0,
             dir: PathBuf::new(),

@@ -1022,6 +1022,12 @@ fn drive(
             d.min, d.median, d.max, d.count
         );
     }
+    if let Some(h) = s.tip_hardening {
+        println!(
+            "  and at adiabatic hardening (1/stress) d stress/d plastic strain = {:.3} / {:.3} / {:.3} (<= 0: the material had localized)",
+            h.min, h.median, h.max
+        );
+    }
     if let Some(t) = s.separation {
         println!("  plug separated at {:.3} us (its cracks arrested through the thickness)", t * 1e6);
     }

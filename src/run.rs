@@ -105,7 +105,11 @@ pub struct RunSummary {
     pub cracks: Vec<(usize, Real, Option<Real>)>,
     /// The own damage of the particles the cracks grew into
     /// ([`crate::fracture::CrackGrowth::tip_damage`]).
-    pub tip_damage: Option<crate::fracture::TipDamage>,
+    pub tip_damage: Option<crate::fracture::TipValues>,
+    /// The adiabatic hardening of the particles the cracks grew into
+    /// ([`crate::fracture::CrackGrowth::tip_hardening`]; ≤ 0 past the
+    /// onset of shear localization).
+    pub tip_hardening: Option<crate::fracture::TipValues>,
     /// When the plug separated (all cracks that cut it out arrested), s.
     pub separation: Option<Real>,
     /// Perforation: when the plug was first cut out of the plate (see
@@ -489,13 +493,14 @@ fn time_loop(
     plots.extend(crate::output::plot_history(&cfg.out_dir)?);
     plots.extend(crate::output::plot_fields(&sim, &cfg.out_dir)?);
     output_wall += t.elapsed();
-    let (cracks, separation, tip_damage) = match &sim.cracks {
+    let (cracks, separation, tip_damage, tip_hardening) = match &sim.cracks {
         Some(c) => (
             c.cracks.iter().map(|k| (k.id, k.nucleated.0, k.arrested.map(|a| a.0))).collect(),
             c.separation_time(sim.model.mode),
             c.tip_damage(),
+            c.tip_hardening(),
         ),
-        None => (Vec::new(), None, None),
+        None => (Vec::new(), None, None, None),
     };
     let rigid_velocities: Vec<(String, [Real; 2])> = sim
         .contact
@@ -527,6 +532,7 @@ fn time_loop(
         exposed: crate::output::exposed_contact_summary(&history),
         cracks,
         tip_damage,
+        tip_hardening,
         separation,
         rigid_velocities,
         last_contacts,

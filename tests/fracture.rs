@@ -198,12 +198,12 @@ fn splits_conserve_mass_and_momentum_and_reproduction() {
 
 #[test]
 fn tip_damage_summary_takes_min_median_max() {
-    use plugsim::fracture::TipDamage;
-    let odd = TipDamage::of(vec![0.3, 0.1, 0.2]).unwrap();
+    use plugsim::fracture::TipValues;
+    let odd = TipValues::of(vec![0.3, 0.1, 0.2]).unwrap();
     assert_eq!((odd.min, odd.median, odd.max, odd.count), (0.1, 0.2, 0.3, 3));
-    let even = TipDamage::of(vec![0.4, 0.1, 0.2, 0.3]).unwrap();
+    let even = TipValues::of(vec![0.4, 0.1, 0.2, 0.3]).unwrap();
     assert_eq!((even.min, even.median, even.max, even.count), (0.1, 0.25, 0.4, 4));
-    assert!(TipDamage::of(Vec::new()).is_none());
+    assert!(TipValues::of(Vec::new()).is_none());
 }
 
 /// Every crack event records the deciding particle's own damage, whatever
@@ -227,6 +227,7 @@ fn crack_events_record_the_tips_own_damage() {
         assert!(e.value >= 0.3, "the effective strain decided: {e:?}");
         assert!(e.hardening.is_nan(), "an elastic body has no flow stress to soften: {e:?}");
     }
+    assert_eq!(g.tip_hardening(), None);
     let summary = g.tip_damage().unwrap();
     let grown = g.events.iter().filter(|e| e.kind != EventKind::Arrest).count();
     assert_eq!(summary.count, grown);
@@ -252,6 +253,9 @@ fn crack_events_record_the_tips_own_damage() {
         assert!((e.damage - e.value).abs() <= 1e-12 * e.value.abs(), "{e:?}");
         assert!((e.hardening - expected).abs() <= 1e-12 * expected, "{e:?} against {expected}");
     }
+    let h = g.tip_hardening().unwrap();
+    assert_eq!(h.count, g.events.iter().filter(|e| e.kind != EventKind::Arrest).count());
+    assert!((h.min - expected).abs() <= 1e-12 * expected && (h.max - expected).abs() <= 1e-12 * expected, "{h:?}");
 }
 
 #[test]

@@ -154,10 +154,11 @@ pub struct CrackEvent {
     pub hardening: Real,
 }
 
-/// Summary of the own damage of the particles the cracks grew into
-/// ([`CrackGrowth::tip_damage`]): the locus is `D = 1`.
+/// Summary of one quantity over the particles the cracks grew into
+/// ([`CrackGrowth::tip_damage`]: the locus is `D = 1`;
+/// [`CrackGrowth::tip_hardening`]: ≤ 0 past the onset of localization).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TipDamage {
+pub struct TipValues {
     pub min: Real,
     /// The median (the mean of the middle two for an even count).
     pub median: Real,
@@ -166,16 +167,16 @@ pub struct TipDamage {
     pub count: usize,
 }
 
-impl TipDamage {
+impl TipValues {
     /// Summary of `values` (finite), `None` if empty.
     pub fn of(mut values: Vec<Real>) -> Option<Self> {
         if values.is_empty() {
             return None;
         }
-        values.sort_by(|a, b| a.partial_cmp(b).expect("finite damage"));
+        values.sort_by(|a, b| a.partial_cmp(b).expect("finite values"));
         let n = values.len();
         let median = if n % 2 == 1 { values[n / 2] } else { 0.5 * (values[n / 2 - 1] + values[n / 2]) };
-        Some(TipDamage { min: values[0], median, max: values[n - 1], count: n })
+        Some(TipValues { min: values[0], median, max: values[n - 1], count: n })
     }
 }
 
@@ -454,14 +455,22 @@ impl CrackGrowth {
     /// How far along its locus the material was where the cracks grew:
     /// the own damage ([`CrackEvent::damage`]) of the particles that
     /// nucleation and propagation made tips, `None` before any.
-    pub fn tip_damage(&self) -> Option<TipDamage> {
-        let d: Vec<Real> = self
-            .events
-            .iter()
-            .filter(|e| e.kind != EventKind::Arrest && e.damage.is_finite())
-            .map(|e| e.damage)
-            .collect();
-        TipDamage::of(d)
+    pub fn tip_damage(&self) -> Option<TipValues> {
+        self.tip_values(|e| e.damage)
+    }
+
+    /// Whether the material had localized where the cracks grew: the
+    /// adiabatic hardening ([`CrackEvent::hardening`]) of the particles
+    /// that nucleation and propagation made tips, `None` before any (or in
+    /// an elastic body).
+    pub fn tip_hardening(&self) -> Option<TipValues> {
+        self.tip_values(|e| e.hardening)
+    }
+
+    fn tip_values(&self, value: impl Fn(&CrackEvent) -> Real) -> Option<TipValues> {
+        let v: Vec<Real> =
+            self.events.iter().filter(|e| e.kind != EventKind::Arrest).map(value).filter(|v| v.is_finite()).collect();
+        TipValues::of(v)
     }
 
     /// Time of plug separation: when the through-cracks that cut a plug

@@ -283,7 +283,7 @@ pub mod nonlocal;
 pub mod tip_speed;
 pub mod visibility;
 
-pub use growth::{Crack, CrackEvent, CrackGrowth, CrackVertex, EventKind, TipDamage};
+pub use growth::{Crack, CrackEvent, CrackGrowth, CrackVertex, EventKind, TipValues};
 pub use visibility::{CrackSegments, CrackVisibility};
 
 use crate::math::Real;
