@@ -758,7 +758,12 @@ pub fn report(header: &str, study: &Study) -> String {
             ));
         }
         if let Some(v) = l.non_monotonic {
-            s.push_str(&format!("Note: the plate held at {v:.2} m/s, above the lowest perforating speed.\n\n"));
+            s.push_str(&format!(
+                "Zone of mixed results: the plate held at {v:.2} m/s, above the lowest perforating speed ({:.2} m/s): \
+                 the outcome is not monotone in the speed between them, and v_bl above is the lower edge of that \
+                 zone (near the limit a crack tip that waits at the threshold may run or stall; docs/validation.md).\n\n",
+                l.perforated.unwrap_or(0.0)
+            ));
         }
     }
     match &study.fit {
@@ -1057,6 +1062,38 @@ mod tests {
         assert_eq!(bracket(&shots), (Some(150.0), Some(170.0), Some(180.0)));
         let limit = Limit { held: Some(150.0), perforated: Some(170.0), tol: 1.0, non_monotonic: None };
         assert_eq!(limit.estimate(), Some((160.0, 10.0)));
+    }
+
+    /// Case II's plate at 24 rows (docs/validation.md): perforated at
+    /// 123.33, held at 125.21 and 128.40, perforated at 130 m/s. The report
+    /// names the zone of mixed results with both its edges.
+    #[test]
+    fn the_report_names_a_zone_of_mixed_results() {
+        let held = Verdict::Held { since: 0.0 };
+        let perf = |v| Verdict::Perforated { residual: v, since: 0.0 };
+        let shots = vec![
+            shot(121.85, held),
+            shot(123.33, perf(50.5)),
+            shot(125.21, held),
+            shot(128.4, held),
+            shot(130.0, perf(37.2)),
+        ];
+        let (h, p, above) = bracket(&shots);
+        assert_eq!((h, p, above), (Some(121.85), Some(123.33), Some(128.4)));
+        let study = Study {
+            shots,
+            failures: vec![],
+            interrupted: false,
+            limit: Some(Limit { held: h, perforated: p, tol: 1.0, non_monotonic: above }),
+            fit: None,
+        };
+        let text = report("header", &study);
+        assert!(
+            text.contains("Zone of mixed results: the plate held at 128.40 m/s") && text.contains("(123.33 m/s)"),
+            "{text}"
+        );
+        let monotone = Study { limit: Some(Limit { non_monotonic: None, ..study.limit.clone().unwrap() }), ..study };
+        assert!(!report("header", &monotone).contains("mixed results"));
     }
 
     #[test]
