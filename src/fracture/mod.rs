@@ -259,7 +259,13 @@
 //!   slow, Case II not perforated); the experiments are met at an average
 //!   of 0.30–0.41, a third of the locus. The shortfall is in the locus
 //!   or the material (shear tests needed), not in how the criterion reads
-//!   the field (`docs/validation.md`, "Why the limits are low"). Not a
+//!   the field (`docs/validation.md`, "Why the limits are low"). Near the
+//!   limit `D̄` at the tip's candidates plateaus just under the threshold,
+//!   so a few per cent decide whether the tip runs now or tens of µs
+//!   later: the outcome alternates with the impact speed (Case II's plate
+//!   at 24 rows perforates at 123.3 and 130 m/s, holds at 125.2 and
+//!   128.4), and deciding the advance a fixed distance ahead of the tip
+//!   (0.5 or 1 mm) moved the 12- and 24-row limits apart. Not a
 //!   ballistic fit of `w`: `w = 0.4 mm` makes the limits scale with the
 //!   thickness (168.1, 172.1, 187.9 m/s at 12 rows for 10.2, 11.1, 12 mm)
 //!   but misses Case II by −23 %.
