@@ -224,7 +224,8 @@ fn a_slave_starting_inside_a_deformable_master_is_not_thrown_out() {
 /// anvil, or head on into its mirror image flying at 200 m/s the other
 /// way (each bar at v toward the other, the closing speed 2 v: the plane
 /// between them stays at rest, as the anvil's face does; "one bar at v/2
-/// each" would be the anvil at v/2).
+/// each" would be the anvil at v/2). No cracks (`criterion = "none"`): a
+/// test of the contact, not of the fracture model.
 fn taylor(mirror: bool) -> Case {
     let bar = |name: &str, y: [Real; 2], v: Real| {
         format!(
@@ -239,7 +240,8 @@ velocity = [0.0, {v}]
             y[0], y[1]
         )
     };
-    let mut text = String::from("[geometry]\nmode = \"axisymmetric\"\n[time]\nend = 40.0e-6\n");
+    let mut text =
+        String::from("[geometry]\nmode = \"axisymmetric\"\n[time]\nend = 40.0e-6\n[fracture]\ncriterion = \"none\"\n");
     text += &bar("bar", [0.00005, 0.01005], -200.0);
     if mirror {
         text += &bar("mirror", [-0.01005, -0.00005], 200.0);
@@ -277,8 +279,10 @@ fn rod_on_rod_gives_the_final_length_of_rod_on_anvil() {
     };
     let (anvil, _) = run(false);
     let (rod, sim) = run(true);
-    // Measured: anvil 8.4566 mm, rod on rod 8.4552 mm (-0.017 %); the bar
-    // rebounds at 12.3 m/s by then.
+    // Measured without cracks (the bars' faces would nucleate one, a
+    // threshold event whose timing differs between the two runs and is not
+    // what this contact test is about): anvil 8.4560 mm, rod on rod
+    // 8.4582 mm (+0.026 %); the bar rebounds at 12.4 m/s by then.
     let mass: Real = sim.model.particles.mass[sim.model.bodies[0].particles.clone()].iter().sum();
     let v = body_momentum(&sim, 0).y / mass;
     assert!(v > 0.0, "the bar must have stopped deforming and rebound ({v} m/s)");

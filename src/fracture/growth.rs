@@ -433,6 +433,21 @@ impl CrackGrowth {
         lumped_projection(model, i, |q| model.quad.damage[q])
     }
 
+    /// Smallest radius at which a crack may nucleate, m: in axisymmetry
+    /// with `"nonlocal_damage"`, the averaging length `ℓ` — a ring crack
+    /// nearer the axis is a core thinner than the ball its criterion
+    /// averages over (the axis truncates the ball there), held by the axis
+    /// particles, whose masses shrink as `h³` (module doc of
+    /// [`crate::fracture`]); otherwise no limit (`−∞`: the per-particle
+    /// criteria keep \[RL10\]'s behaviour, and plane strain has no axis).
+    fn smallest_ring_radius(&self, model: &Model) -> Real {
+        if model.mode == GeometryMode::Axisymmetric && self.params.criterion == Criterion::NonlocalDamage {
+            self.params.nonlocal_radius
+        } else {
+            Real::NEG_INFINITY
+        }
+    }
+
     /// Stress triaxiality `σ_m / σ_eq` at particle `i`: the ratio of the
     /// lumped projections of the quadrature points' mean and von Mises
     /// stresses (the same weights as [`Self::criterion_value`]).
@@ -672,13 +687,17 @@ impl CrackGrowth {
     ) -> Result<Vec<usize>, FractureError> {
         // In parallel (the scan visits every surface particle each step);
         // the collected order is the index order either way.
+        let min_radius = self.smallest_ring_radius(model);
         let mut cores: Vec<(Real, usize)> = (0..model.particles.len())
             .into_par_iter()
             .filter(|&i| {
                 let f = model.particles.flags[i];
                 // The axis is a boundary of the r-z section but no surface
                 // of the body: no crack starts there.
-                f.has(ParticleFlags::SLAVE) && !f.has(ParticleFlags::CRACK_FACE) && !f.has(ParticleFlags::ON_AXIS)
+                f.has(ParticleFlags::SLAVE)
+                    && !f.has(ParticleFlags::CRACK_FACE)
+                    && !f.has(ParticleFlags::ON_AXIS)
+                    && model.particles.x0[i].x >= min_radius
             })
             .map(|i| (self.criterion_value(model, i), i))
             .filter(|&(v, i)| v >= critical && self.triaxiality(model, i) >= NUCLEATION_MIN_TRIAXIALITY)

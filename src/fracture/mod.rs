@@ -46,7 +46,17 @@
 //!   (`one_crack_nucleates_per_failed_zone`) — or on the axis in
 //!   axisymmetry (flagged surface and slave as an edge of the r-z section,
 //!   but no surface of the body; `no_crack_nucleates_on_the_axis`,
-//!   `axisymmetric_crack_starts_at_the_corner_not_on_the_axis`). The
+//!   `axisymmetric_crack_starts_at_the_corner_not_on_the_axis`) — or, with
+//!   `"nonlocal_damage"` in axisymmetry, within the averaging length `ℓ`
+//!   of the axis: such a ring crack is a core thinner than the ball its
+//!   own criterion averages over (the axis truncates the ball there), cut
+//!   out of the axis particles, whose masses shrink as `h³`. Børvik's
+//!   12 mm plate at 48 rows and 300 m/s started one at r = 0.26 mm under
+//!   the projectile (where the release converging on the axis pulls the
+//!   face), cut a half-millimetre core along the axis, threw a
+//!   1.3·10⁻⁸ kg child at 3140 m/s and stopped with unbounded
+//!   temperatures (`no_ring_crack_nucleates_within_the_averaging_length_of_the_axis`;
+//!   docs/validation.md). \[RL10\]'s criteria keep their nucleation. The
 //!   failed-zone rule is what keeps the number of cracks independent of the
 //!   resolution: the distance rule counts spacings, and in the fine Borvik
 //!   plane-strain model (48 rows) the failed zone under each projectile
