@@ -539,7 +539,7 @@ fn no_ring_crack_nucleates_within_the_averaging_length_of_the_axis() {
     let top = 8.0 * H;
     let patch =
         |r0: Real| move |x: &Vec2| if x.x >= r0 && x.x <= r0 + 2.0 * H && x.y > top - 2.5 * H { 0.9 } else { 0.0 };
-    let run = |criterion: Criterion, r0: Real| {
+    let patched = |r0: Real| {
         let mut m = plate_in(GeometryMode::Axisymmetric, 25, 9);
         let f = patch(r0);
         for q in 0..m.quad.len() {
@@ -547,6 +547,10 @@ fn no_ring_crack_nucleates_within_the_averaging_length_of_the_axis() {
             m.quad.damage[q] = v;
             m.quad.eps_p[q] = v;
         }
+        m
+    };
+    let run = |criterion: Criterion, r0: Real| {
+        let mut m = patched(r0);
         let mut g = CrackGrowth::new(params(criterion));
         drive(&mut m, &mut g, 3);
         g
@@ -557,14 +561,7 @@ fn no_ring_crack_nucleates_within_the_averaging_length_of_the_axis() {
     assert!(near.cracks.iter().all(|c| c.vertices[0].x0.x >= l), "a core inside l: {:?}", near.cracks);
     // Without the rule the particle on the top face at r = H would start
     // one: it meets the criterion with the highest average off the axis.
-    let m = {
-        let mut m = plate_in(GeometryMode::Axisymmetric, 25, 9);
-        let f = patch(0.0);
-        for q in 0..m.quad.len() {
-            m.quad.damage[q] = f(&m.quad.x0[q]);
-        }
-        m
-    };
+    let m = patched(0.0);
     let g = CrackGrowth::new(params(Criterion::NonlocalDamage));
     let critical = g.params.critical_value().unwrap();
     let inside = g.criterion_value(&m, id(&m, 1, 8));

@@ -55,8 +55,6 @@ pub fn nodal_mass(model: &Model, i: usize) -> Real {
     rho * p.volume[i] * factor
 }
 
-/// The lumped projection of the quadrature values `col` at particle `i`,
-/// `Σ_q N_i(X_q) w_q c_q / Σ_q N_i(X_q) w_q` (0 without points).
 /// The event of `kind` at `(time, step)` on `crack`, decided by particle
 /// `decider` with criterion value `value`: its particle list holds the new
 /// tip for nucleation and propagation (the split's children are put in
@@ -83,6 +81,8 @@ fn logged_event(
     CrackEvent { time: at.0, step: at.1, crack, kind, particles, value, damage, hardening }
 }
 
+/// The lumped projection of the quadrature values `value(q)` at particle
+/// `i`, `Σ_q N_i(X_q) w_q c_q / Σ_q N_i(X_q) w_q` (0 without points).
 fn lumped_projection(model: &Model, i: usize, value: impl Fn(usize) -> Real) -> Real {
     let (mut acc, mut wsum) = (0.0, 0.0);
     for j in model.gather.range(i) {

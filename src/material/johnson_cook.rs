@@ -534,7 +534,9 @@ impl JohnsonCook {
     /// rate sensitivity or by conduction, so an early bound). At `g ≤ 0`
     /// (melted or fully damaged and coupled) the point carries no shear:
     /// `−∞`. A diagnostic (output field `adiabatic_hardening`); no crack
-    /// criterion reads it. Test: `adiabatic_hardening_vanishes_at_the_peak_of_the_adiabatic_curve`.
+    /// criterion reads it. Tests (`tests/material.rs`):
+    /// `adiabatic_hardening_vanishes_at_the_peak_of_the_closed_form_adiabatic_curve`,
+    /// `adiabatic_hardening_changes_sign_at_the_peak_of_the_driven_shear_curve`.
     pub fn adiabatic_hardening(&self, eps_p: Real, temperature: Real, damage: Real, rate: Real) -> Real {
         let fs = self.flow_stress_slopes(eps_p, temperature, damage);
         if fs.g <= 0.0 {

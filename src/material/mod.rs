@@ -174,9 +174,7 @@ impl Material {
             }),
         }
     }
-}
 
-impl Material {
     /// [`JohnsonCook::adiabatic_hardening`] of a point in this material at
     /// plastic strain `eps_p`, `temperature`, `damage` and plastic rate
     /// `rate`; `None` for an elastic material (no flow stress).
