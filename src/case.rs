@@ -388,6 +388,11 @@ pub struct TimeSpec {
     /// held). Default: run to `end`.
     #[serde(default)]
     pub stop_after_release: Option<Real>,
+    /// Artificial bulk viscosity, `{ linear = b₁, quadratic = b₂ }` (either
+    /// may be left out for the common codes' 0.06 and 1.2): a deviation
+    /// from SPEC §5, off when absent ([`crate::bulk_viscosity`]).
+    #[serde(default)]
+    pub bulk_viscosity: Option<crate::bulk_viscosity::BulkViscosity>,
 }
 
 fn half() -> Real {
@@ -731,6 +736,9 @@ impl Case {
         if let Some(t) = self.time.stop_after_release {
             positive(&mut add, "time.stop_after_release", t, "s");
         }
+        for (key, message) in self.time.bulk_viscosity.map_or(Vec::new(), |b| b.problems()) {
+            add(format!("time.bulk_viscosity.{key}"), message);
+        }
         if let Some(dt) = self.time.fixed_dt {
             positive(&mut add, "time.fixed_dt", dt, "s");
             if dt > self.time.end {
@@ -961,6 +969,12 @@ impl Case {
         !self.rigid_bodies.is_empty()
             || (self.contact.deformable && self.bodies.len() > 1)
             || (self.contact.self_contact && self.fracture.criterion != crate::fracture::Criterion::None)
+    }
+
+    /// The artificial bulk viscosity ([`crate::bulk_viscosity`]; none
+    /// unless `[time] bulk_viscosity` is given).
+    pub fn bulk_viscosity(&self) -> crate::bulk_viscosity::BulkViscosity {
+        self.time.bulk_viscosity.unwrap_or(crate::bulk_viscosity::BulkViscosity::NONE)
     }
 
     /// The time-step rule.

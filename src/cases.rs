@@ -109,6 +109,11 @@ pub const BUILTIN_CASES: &[(&str, &str, &str)] = &[
         "Borvik Case II (173.7 m/s, 10.2 mm), axisymmetric, coarse, effective-strain cracks",
     ),
     (
+        "borvik-2-axisymmetric-deformable",
+        include_str!("../cases/borvik-2-axisymmetric-deformable.toml"),
+        "Borvik Case II (173.7 m/s, 10.2 mm), axisymmetric, coarse, deformable tool-steel projectile",
+    ),
+    (
         "borvik-2-axisymmetric-damage",
         include_str!("../cases/borvik-2-axisymmetric-damage.toml"),
         "Borvik Case II (173.7 m/s, 10.2 mm), axisymmetric, coarse, damage cracks",
@@ -218,10 +223,11 @@ pub const BUILTIN_CASES: &[(&str, &str, &str)] = &[
 /// nose is missing: its apex angle was not found.
 pub const BORVIK_NOSE_CASES: &[&str] = &["borvik-2002-12mm-blunt", "borvik-2002-12mm-hemispherical"];
 
-/// Børvik's Case I with the projectile as a deformable body of hardened
-/// Arne tool steel (issue #20), beside the rigid one; the numerical
-/// parameters of the coarse axisymmetric member of [`borvik_family`].
-pub const BORVIK_DEFORMABLE_CASES: &[&str] = &["borvik-1-axisymmetric-deformable"];
+/// Børvik's Cases I and II with the projectile as a deformable body of
+/// hardened Arne tool steel (issue #20), beside the rigid one; the
+/// numerical parameters of the coarse axisymmetric members of
+/// [`borvik_family`].
+pub const BORVIK_DEFORMABLE_CASES: &[&str] = &["borvik-1-axisymmetric-deformable", "borvik-2-axisymmetric-deformable"];
 
 /// Short names for the paper's models: `(alias, built-in case)`.
 pub const ALIASES: &[(&str, &str)] = &[("borvik-1", "borvik-1-plane-strain"), ("borvik-2", "borvik-2-plane-strain")];

@@ -80,6 +80,8 @@ pub struct GeneratedBody {
     pub quad_points: Vec<Vec2>,
     /// Quadrature weights including the geometry factor.
     pub quad_weights: Vec<Real>,
+    /// Length of each quadrature point's background cell, `√(Δx Δy)`, m.
+    pub quad_lengths: Vec<Real>,
     /// Columns and rows of the particle grid.
     pub columns: usize,
     pub rows: usize,
@@ -197,6 +199,7 @@ impl RectangleGrid {
                         let w = wa * wc * 0.25 * (x1 - x0) * (y1 - y0) * mode.volume_factor(&p);
                         b.quad_points.push(p);
                         b.quad_weights.push(w);
+                        b.quad_lengths.push(((x1 - x0) * (y1 - y0)).sqrt());
                     }
                 }
             }
@@ -220,6 +223,7 @@ impl GeneratedBody {
         let order = morton_order(&self.quad_points);
         self.quad_points = order.iter().map(|&i| self.quad_points[i]).collect();
         self.quad_weights = order.iter().map(|&i| self.quad_weights[i]).collect();
+        self.quad_lengths = order.iter().map(|&i| self.quad_lengths[i]).collect();
     }
 }
 

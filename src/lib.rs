@@ -4,6 +4,7 @@
 
 pub mod ballistic;
 pub mod bench;
+pub mod bulk_viscosity;
 pub mod case;
 pub mod cases;
 pub mod checkpoint;

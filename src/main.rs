@@ -959,6 +959,12 @@ fn drive(
         100.0 * s.energies.drift(),
         100.0 * s.max_drift
     );
+    if s.bulk_viscosity.is_active() {
+        println!(
+            "  bulk viscosity: linear {}, quadratic {} (not in SPEC §5; its work is in the internal energy)",
+            s.bulk_viscosity.linear, s.bulk_viscosity.quadratic
+        );
+    }
     if s.max_drift > 0.05 {
         println!("  WARNING: the energy balance drifted by more than 5 % of the input energy");
     }

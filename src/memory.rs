@@ -20,9 +20,9 @@ use crate::math::Real;
 /// about 250 B), rounded up.
 pub const BYTES_PER_PARTICLE: Real = 450.0;
 /// Bytes held per quadrature point outside the shape tables: position,
-/// weight, body, `F`, `τ` and `P w` (their five block entries) and four
-/// scalars (180 B), the step's work scratch (8 B) and the table row offset
-/// (8 B), rounded up.
+/// weight, cell length, body, `F`, `τ` and `P w` (their five block
+/// entries) and four scalars (188 B), the step's work scratch (8 B) and the
+/// table row offset (8 B), rounded up.
 pub const BYTES_PER_QUADRATURE_POINT: Real = 256.0;
 /// Bytes per entry of a shape table: particle index (4 B), value (8 B),
 /// gradient (16 B), and for the quadrature table its gather entry (table

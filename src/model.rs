@@ -407,8 +407,8 @@ impl Model {
             let p_end = particles.len();
             let q_start = quad.len();
             let s0 = PointState::at_rest(t0);
-            for (x, w) in g.quad_points.iter().zip(&g.quad_weights) {
-                quad.push(*x, *w, b as u32, &s0);
+            for ((x, w), l) in g.quad_points.iter().zip(&g.quad_weights).zip(&g.quad_lengths) {
+                quad.push(*x, *w, *l, b as u32, &s0);
             }
             let shape_err = |source| ModelError::Shape { body: setup.name.clone(), source };
             let x0 = &particles.x0[p_start..p_end];

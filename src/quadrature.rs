@@ -12,6 +12,10 @@ pub struct QuadraturePoints {
     /// Integration weight `w_q` including the geometry factor
     /// (cell area × Gauss weight, × 2πR_q in axisymmetry), m³ (m² per unit depth).
     pub weight: Vec<Real>,
+    /// Length of the point's background cell in the reference lattice,
+    /// `√(Δx Δy)`, m: the `L₀` of the bulk viscosity
+    /// ([`crate::bulk_viscosity`]).
+    pub length: Vec<Real>,
     /// Body index (selects the material).
     pub body: Vec<u32>,
     /// Current deformation gradient `F`, in the block form of 2D kinematics
@@ -72,6 +76,7 @@ impl QuadraturePoints {
         let QuadraturePoints {
             x0,
             weight,
+            length,
             body,
             eroded,
             f_carry_slot,
@@ -87,15 +92,16 @@ impl QuadraturePoints {
         } = self;
         let n = x0.len();
         let columns = [weight.len(), body.len(), eroded.len(), f_carry_slot.len(), f.len(), tau.len(), pw.len()];
-        let more_columns = [pw_zz.len(), eps_p.len(), eps_p_rate.len(), temperature.len(), damage.len()];
+        let more_columns = [pw_zz.len(), eps_p.len(), eps_p_rate.len(), temperature.len(), damage.len(), length.len()];
         columns.iter().chain(&more_columns).all(|&l| l == n)
             && f_carry_slot.iter().all(|&s| s == NO_CARRY || (s as usize) < f_carry.len())
     }
 
     /// Append a point in the given state.
-    pub fn push(&mut self, x0: Vec2, weight: Real, body: u32, s: &PointState) {
+    pub fn push(&mut self, x0: Vec2, weight: Real, length: Real, body: u32, s: &PointState) {
         self.x0.push(x0);
         self.weight.push(weight);
+        self.length.push(length);
         self.body.push(body);
         self.f.push(Block2::identity_scaled(1.0));
         self.tau.push(Block2::block_part(&s.tau));

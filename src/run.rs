@@ -87,6 +87,9 @@ pub struct RunSummary {
     pub output_wall: Duration,
     pub stage_timers: Vec<(&'static str, Duration)>,
     pub energies: crate::step::Energies,
+    /// The artificial bulk viscosity the run used ([`crate::bulk_viscosity`];
+    /// its work is in the internal energy).
+    pub bulk_viscosity: crate::bulk_viscosity::BulkViscosity,
     /// Largest |energy drift| seen at a history row.
     pub max_drift: Real,
     /// The fastest particle of the run ([`crate::step::Simulation::fastest`]).
@@ -209,6 +212,7 @@ pub fn build_simulation(case: &Case) -> Result<Simulation, RunError> {
     let mut sim = build_simulation_without_cracks(case)?;
     sim.heat = case.heat_conduction_for(&sim.model)?;
     sim.heat_every = case.heat.every;
+    sim.bulk_viscosity = case.bulk_viscosity();
     if case.fracture.criterion != crate::fracture::Criterion::None {
         sim.cracks = Some(crate::fracture::CrackGrowth::new(case.fracture));
     }
@@ -550,6 +554,7 @@ fn time_loop(
         output_wall,
         stage_timers: sim.timers.list(),
         energies: sim.energies,
+        bulk_viscosity: sim.bulk_viscosity,
         max_drift: schedule.max_drift,
         fastest: sim.fastest,
         memory_estimate: preflight(case)?.bytes(),

@@ -1,6 +1,7 @@
 //! The explicit time loop (SPEC §5): one documented stage order, stage
 //! timers, energy bookkeeping and instability detection.
 
+use crate::bulk_viscosity::{current_length, BulkViscosity};
 use crate::contact::{ContactError, ContactSystem, StepInput};
 use crate::fracture::{CrackGrowth, FractureError};
 use crate::geometry::GeometryMode;
@@ -219,6 +220,10 @@ pub struct Simulation {
     /// model on reading, as a fresh run builds it.
     #[serde(skip)]
     pub heat: Option<HeatConduction>,
+    /// Artificial bulk viscosity ([`crate::bulk_viscosity`]; none by
+    /// default). Not in checkpoints: set from the case, as `heat`.
+    #[serde(skip, default = "BulkViscosity::none")]
+    pub bulk_viscosity: BulkViscosity,
     /// Some held (FIX_X / FIX_Y) component moves at a non-zero velocity:
     /// kinematic driving, whose work the energy account does not tally.
     pub driven_constraints: bool,
@@ -291,6 +296,7 @@ impl Simulation {
             driven_constraints,
             contact: None,
             heat: None,
+            bulk_viscosity: BulkViscosity::NONE,
             heat_every: 1,
             heat_pending: 0.0,
             f_contact: vec![Vec2::zeros(); np],
@@ -540,6 +546,7 @@ impl Simulation {
         let (tab, u, v, mode, mats) = (&m.qp_shape, &m.particles.u, &m.particles.v, m.mode, &m.materials);
         let q = &mut m.quad;
         let (carried, x0s, weights, bodies) = (&q.f_carry, &q.x0, &q.weight, &q.body);
+        let (viscosity, lengths) = (self.bulk_viscosity, &q.length);
         // One point's update, entry `k` of piece `c`; `Some((point, J))` if it
         // inverts and is not eroded.
         let point = |c: &mut PieceColumns, k: usize| {
@@ -600,12 +607,25 @@ impl Simulation {
             // updates are sums and block products of `τ`, `d` and `w`).
             debug_assert!(is_block_2d(&new.tau), "material update left the block form at point {qi}");
             let new_tau = Block2::block_part(&new.tau);
-            c.work[k] = 0.5 * c.tau[k].add(&new_tau).ddot(&kin.l.sym()) * dt * w;
+            let d = kin.l.sym();
+            c.work[k] = 0.5 * c.tau[k].add(&new_tau).ddot(&d) * dt * w;
+            // The force's stress: the material's, less the viscous pressure
+            // (Kirchhoff, `J q`; `crate::bulk_viscosity`), whose work joins
+            // the internal energy.
+            let mut force_tau = new_tau;
+            if viscosity.is_active() {
+                let mat = &mats[body as usize];
+                let length = current_length(lengths[qi], F_new.xx * F_new.yy - F_new.xy * F_new.yx);
+                let rate = d.trace();
+                let q = viscosity.pressure(mat.density() / J, mat.longitudinal_wave_speed(), length, rate);
+                force_tau = new_tau.sub(&Block2::identity_scaled(J * q));
+                c.work[k] -= J * q * rate * dt * w;
+            }
             c.f[k] = F_new;
             c.tau[k] = new_tau;
             (c.eps_p[k], c.eps_p_rate[k], c.temperature[k], c.damage[k]) =
                 (new.eps_p, new.eps_p_rate, new.temperature, new.damage);
-            c.set_pw(k, &new_tau.mul_transpose(&kin.f_inv).scale(w));
+            c.set_pw(k, &force_tau.mul_transpose(&kin.f_inv).scale(w));
             None
         };
         // Pieces of points, each swept by a plain loop: cheaper than

@@ -148,3 +148,18 @@ fn bodies_overlapping_at_the_start_are_refused_naming_both() {
     assert!(err.contains("bodies[1].rectangle") && err.contains("'backing' overlaps body 'plate'"), "{err}");
     Case::from_str_with(&two_plates(0.0), "ok.toml", &[]).unwrap();
 }
+
+#[test]
+fn bulk_viscosity_is_off_unless_asked_and_its_coefficients_are_checked() {
+    use plugsim::bulk_viscosity::BulkViscosity;
+    let case = Case::from_str_with(GOOD, "good.toml", &[]).unwrap();
+    assert_eq!(case.bulk_viscosity(), BulkViscosity::NONE);
+    // either coefficient may be left out for the common codes' value
+    let on = with("end = 30.0e-6", "end = 30.0e-6\nbulk_viscosity = { quadratic = 1.5 }");
+    let case = Case::from_str_with(&on, "on.toml", &[]).unwrap();
+    assert_eq!(case.bulk_viscosity(), BulkViscosity { linear: 0.06, quadratic: 1.5 });
+    let s = err_of(&with("end = 30.0e-6", "end = 30.0e-6\nbulk_viscosity = { linear = 1.2 }"));
+    assert!(s.contains("time.bulk_viscosity.linear"), "{s}");
+    let s = err_of(&with("end = 30.0e-6", "end = 30.0e-6\nbulk_viscosity = { linaer = 0.1 }"));
+    assert!(s.contains("linaer"), "{s}");
+}
