@@ -1,10 +1,12 @@
-//! `plugsim ballistic`: a case with a rigid projectile run at several impact
+//! `plugsim ballistic`: a case with a projectile run at several impact
 //! speeds, side by side, and its ballistic limit found by bisection; the
 //! `v_i → v_r` table, the Recht–Ipson fit and its plot (SPEC §10).
 //!
 //! - **Impact speed**: the projectile's initial velocity keeps its direction
-//!   and takes the given magnitude. The projectile is the case's one rigid
-//!   body with a non-zero initial velocity, or the one named.
+//!   and takes the given magnitude. The projectile ([`Projectile`]) is the
+//!   case's one moving body — a rigid body with a non-zero initial velocity,
+//!   or a deformable body given one over its whole body (issue #20) — or
+//!   the one named.
 //! - **Outcome** of a run ([`crate::residual`]): *perforated* (a plug cut
 //!   out and the force along the flight vanished: `v_r` its speed along the
 //!   flight at the end), *held* (stopped or bounced back: `v_r = 0`), or
@@ -55,11 +57,11 @@ pub const WIDEN_TRIES: usize = 3;
 /// Why a ballistic study cannot start or stopped.
 #[derive(Debug, thiserror::Error)]
 pub enum BallisticError {
-    #[error("case {case} has no rigid body with an initial velocity to use as the projectile (rigid bodies: {})", list(.bodies))]
+    #[error("case {case} has no moving body to use as the projectile: no rigid body with an initial velocity (rigid bodies: {}), no deformable body given one over its whole body", list(.bodies))]
     NoProjectile { case: String, bodies: Vec<String> },
-    #[error("case {case} has several moving rigid bodies ({}); name the projectile with --projectile", list(.names))]
+    #[error("case {case} has several moving bodies ({}); name the projectile with --projectile", list(.names))]
     SeveralProjectiles { case: String, names: Vec<String> },
-    #[error("case {case} has no rigid body named '{name}' (rigid bodies: {})", list(.bodies))]
+    #[error("case {case} has no moving body named '{name}' (moving bodies: {})", list(.bodies))]
     UnknownProjectile { case: String, name: String, bodies: Vec<String> },
     #[error("rigid body '{name}' of case {case} is prescribed (it moves at its velocity whatever the forces): it has no residual velocity")]
     Prescribed { case: String, name: String },
@@ -90,8 +92,8 @@ pub struct Setup {
     pub label: String,
     /// The `--set` overrides, for the report and each run's provenance.
     pub overrides: Vec<String>,
-    /// Index of the projectile among the case's rigid bodies.
-    pub projectile: usize,
+    /// The body the study fires.
+    pub projectile: Projectile,
     /// Runs at once.
     pub jobs: usize,
     /// Worker threads of each run.
@@ -102,50 +104,110 @@ pub struct Setup {
     pub interrupt: Option<Arc<AtomicBool>>,
 }
 
-/// The projectile of `case`: the rigid body named `name`, else its only
-/// rigid body with a non-zero initial velocity.
-pub fn select_projectile(case: &Case, label: &str, name: Option<&str>) -> Result<usize, BallisticError> {
-    let bodies: Vec<String> = case.rigid_bodies.iter().map(|r| r.name.clone()).collect();
-    let index = match name {
-        Some(n) => bodies.iter().position(|b| b == n).ok_or_else(|| BallisticError::UnknownProjectile {
-            case: label.into(),
-            name: n.into(),
-            bodies: bodies.clone(),
-        })?,
-        None => {
-            let moving: Vec<usize> =
-                (0..bodies.len()).filter(|&k| case.rigid_bodies[k].velocity.iter().any(|&v| v != 0.0)).collect();
-            match moving.as_slice() {
-                [k] => *k,
-                [] => return Err(BallisticError::NoProjectile { case: label.into(), bodies }),
-                _ => {
-                    let names = moving.iter().map(|&k| bodies[k].clone()).collect();
-                    return Err(BallisticError::SeveralProjectiles { case: label.into(), names });
+/// The body a study fires.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Projectile {
+    /// A rigid body, by its index among the case's rigid bodies.
+    Rigid(usize),
+    /// A deformable body flying as a whole (an `initial_velocity` entry
+    /// without a region, [`Case::deformable_flights`]), by its index among
+    /// the case's bodies.
+    Deformable(usize),
+}
+
+impl Projectile {
+    /// Its name in `case` (that of its history columns and flight).
+    pub fn name(self, case: &Case) -> &str {
+        match self {
+            Projectile::Rigid(k) => &case.rigid_bodies[k].name,
+            Projectile::Deformable(b) => &case.bodies[b].name,
+        }
+    }
+
+    /// Its initial velocity in `case`, m/s (a deformable body's: the last
+    /// entry over the whole body, as [`Case::deformable_flights`] reads it).
+    pub fn velocity(self, case: &Case) -> Vec2 {
+        let v = match self {
+            Projectile::Rigid(k) => case.rigid_bodies[k].velocity,
+            Projectile::Deformable(b) => case.bodies[b]
+                .initial_velocity
+                .iter()
+                .rev()
+                .find(|iv| iv.region.is_none())
+                .map_or([0.0; 2], |iv| iv.velocity),
+        };
+        Vec2::new(v[0], v[1])
+    }
+
+    /// Set its initial velocity in `case` to `v` (m/s); what a run's
+    /// provenance records of it.
+    fn set_velocity(self, case: &mut Case, v: [Real; 2]) -> String {
+        match self {
+            Projectile::Rigid(k) => {
+                case.rigid_bodies[k].velocity = v;
+                format!("rigid_bodies[{k}].velocity = {v:?}")
+            }
+            Projectile::Deformable(b) => {
+                let body = &mut case.bodies[b];
+                if let Some(iv) = body.initial_velocity.iter_mut().rev().find(|iv| iv.region.is_none()) {
+                    iv.velocity = v;
                 }
+                format!("bodies.{}.initial_velocity (whole body) = {v:?}", body.name)
             }
         }
-    };
-    let spec = &case.rigid_bodies[index];
-    if spec.prescribed {
-        return Err(BallisticError::Prescribed { case: label.into(), name: spec.name.clone() });
     }
-    if spec.velocity.iter().all(|&v| v == 0.0) {
+}
+
+/// The projectile of `case`: the moving body named `name`, else its only
+/// moving body — a rigid body with a non-zero initial velocity (not
+/// prescribed), or a deformable body flying as a whole.
+pub fn select_projectile(case: &Case, label: &str, name: Option<&str>) -> Result<Projectile, BallisticError> {
+    let bodies: Vec<String> = case.rigid_bodies.iter().map(|r| r.name.clone()).collect();
+    let moving: Vec<Projectile> = (0..case.rigid_bodies.len())
+        .filter(|&k| case.rigid_bodies[k].velocity.iter().any(|&v| v != 0.0))
+        .map(Projectile::Rigid)
+        .chain(case.deformable_flights().into_iter().map(|(_, b, _)| Projectile::Deformable(b)))
+        .collect();
+    let names = |list: &[Projectile]| list.iter().map(|p| p.name(case).to_string()).collect::<Vec<_>>();
+    let projectile = match name {
+        Some(n) => {
+            // a rigid body of that name, moving or not (a still one is refused below)
+            let rigid = bodies.iter().position(|b| b == n).map(Projectile::Rigid);
+            rigid.or_else(|| moving.iter().copied().find(|p| p.name(case) == n)).ok_or_else(|| {
+                BallisticError::UnknownProjectile { case: label.into(), name: n.into(), bodies: names(&moving) }
+            })?
+        }
+        None => match moving.as_slice() {
+            [p] => *p,
+            [] => return Err(BallisticError::NoProjectile { case: label.into(), bodies }),
+            _ => return Err(BallisticError::SeveralProjectiles { case: label.into(), names: names(&moving) }),
+        },
+    };
+    if let Projectile::Rigid(k) = projectile {
+        let spec = &case.rigid_bodies[k];
+        if spec.prescribed {
+            return Err(BallisticError::Prescribed { case: label.into(), name: spec.name.clone() });
+        }
+    }
+    if projectile.velocity(case) == Vec2::zeros() {
         return Err(BallisticError::NoProjectile { case: label.into(), bodies });
     }
-    Ok(index)
+    Ok(projectile)
 }
 
 /// The projectile's flight direction (unit) and the case's own impact
 /// speed, m/s.
-pub fn flight(case: &Case, projectile: usize) -> (Vec2, Real) {
-    let v = case.rigid_bodies[projectile].velocity;
-    let v = Vec2::new(v[0], v[1]);
+pub fn flight(case: &Case, projectile: Projectile) -> (Vec2, Real) {
+    let v = projectile.velocity(case);
     (crate::residual::flight_direction(v), v.norm())
 }
 
-/// `case` refined uniformly so that its first deformable body has `rows`
-/// particle rows through its thickness: every deformable body's `layers`
-/// is multiplied by `k = rows / layers₀` (`layers₀` the first body's), its
+/// `case` refined uniformly so that its target — its first deformable body
+/// that does not fly as a whole (not a deformable projectile,
+/// [`Case::deformable_flights`]) — has `rows` particle rows through its
+/// thickness: every deformable body's `layers` (a deformable
+/// projectile's too) is multiplied by `k = rows / layers₀` (`layers₀` the
+/// target's), its
 /// `fine_spacing` and `coarse_spacing` (where given) divided by `k`;
 /// nothing else changes (the fine zone's width and the grading ratio are
 /// geometry, `fracture.nonlocal_radius` and `band_width` material lengths,
@@ -154,10 +216,11 @@ pub fn flight(case: &Case, projectile: usize) -> (Vec2, Real) {
 /// that give it from the original (for the report and to rerun one rung):
 /// at `k = 2` a built-in coarse Børvik case becomes its fine sibling.
 pub fn at_rows(case: &Case, rows: usize) -> Result<(Case, Vec<String>), BallisticError> {
-    let first = case
-        .bodies
-        .first()
-        .ok_or_else(|| BallisticError::Settings("the case has no deformable body to refine".into()))?;
+    let flying: Vec<usize> = case.deformable_flights().into_iter().map(|(_, b, _)| b).collect();
+    let first = (0..case.bodies.len())
+        .find(|b| !flying.contains(b))
+        .map(|b| &case.bodies[b])
+        .ok_or_else(|| BallisticError::Settings("the case has no deformable target to refine".into()))?;
     if rows < 2 {
         return Err(BallisticError::Settings(format!("--rows: at least 2 rows through the thickness, got {rows}")));
     }
@@ -189,13 +252,14 @@ pub fn at_rows(case: &Case, rows: usize) -> Result<(Case, Vec<String>), Ballisti
 }
 
 /// `case` with the projectile at `speed` m/s along its flight direction,
-/// stopping early by [`STOP_AFTER`] unless the case sets its own.
-pub fn at_speed(case: &Case, projectile: usize, speed: Real) -> Case {
+/// stopping early by [`STOP_AFTER`] unless the case sets its own; and what
+/// a run's provenance records of the change.
+pub fn at_speed(case: &Case, projectile: Projectile, speed: Real) -> (Case, String) {
     let mut c = case.clone();
     let (dir, _) = flight(case, projectile);
-    c.rigid_bodies[projectile].velocity = [dir.x * speed, dir.y * speed];
+    let set = projectile.set_velocity(&mut c, [dir.x * speed, dir.y * speed]);
     c.time.stop_after_release.get_or_insert(STOP_AFTER);
-    c
+    (c, set)
 }
 
 /// One run of the study.
@@ -481,13 +545,10 @@ pub fn run_dir(out_dir: &Path, speed: Real) -> PathBuf {
 /// Run the case at `speed`; the event that ends it.
 fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender<Event>) -> Event {
     let t = std::time::Instant::now();
-    let case = at_speed(&setup.case, setup.projectile, speed);
+    let (case, set) = at_speed(&setup.case, setup.projectile, speed);
     let dir = run_dir(&setup.out_dir, speed);
     let mut overrides = setup.overrides.clone();
-    overrides.push(format!(
-        "rigid_bodies[{}].velocity = {:?}",
-        setup.projectile, case.rigid_bodies[setup.projectile].velocity
-    ));
+    overrides.push(set);
     let cfg = RunConfig {
         interrupt: Some(stop.clone()),
         ..RunConfig::new(dir.clone(), true, RunInfo::current(&setup.label, &overrides))
@@ -504,7 +565,7 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
     };
     match execute(&case, &cfg, &mut report) {
         Ok(s) => {
-            let name = &case.rigid_bodies[setup.projectile].name;
+            let name = setup.projectile.name(&case);
             let verdict = s.flights.iter().find(|(n, _)| n == name).map_or(Verdict::NotMoving, |(_, v)| *v);
             Event::Finished {
                 shot: Shot {

@@ -88,7 +88,7 @@ enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
     },
-    /// Run a case with a rigid projectile at several impact speeds and/or find
+    /// Run a case with a projectile (rigid or deformable) at several impact speeds and/or find
     /// its ballistic limit by bisection; writes ballistic.csv, ballistic.md
     /// (table, Recht-Ipson fit) and ballistic.png, and each run's directory.
     Ballistic {
@@ -112,7 +112,7 @@ enum Command {
         /// Tolerance of the limit, +- m/s.
         #[arg(long, default_value_t = 1.0, requires = "limit")]
         tol: f64,
-        /// The rigid body to fire (default: the case's only moving one).
+        /// The body to fire, rigid or deformable (default: the case's only moving one).
         #[arg(long)]
         projectile: Option<String>,
         /// Runs side by side (default: one per core, one thread each).
@@ -643,7 +643,7 @@ fn one_study(
     case: Case,
     file: &str,
     set: &[String],
-    projectile: usize,
+    projectile: plugsim::ballistic::Projectile,
     out_dir: &Path,
     args: &BallisticArgs,
     experiments: &[(f64, f64)],
@@ -667,9 +667,13 @@ fn one_study(
         out_dir: out_dir.to_path_buf(),
         interrupt: interrupt.clone(),
     };
-    let body = &setup.case.rigid_bodies[projectile].name;
+    let body = projectile.name(&setup.case);
+    let kind = match projectile {
+        plugsim::ballistic::Projectile::Rigid(_) => "",
+        plugsim::ballistic::Projectile::Deformable(_) => ", deformable: v_r its mass-averaged velocity",
+    };
     let header = format!(
-        "Case {file}{}; projectile `{body}` (case impact speed {impact:.1} m/s); {jobs} runs side by side, {threads_per_run} thread(s) each; \
+        "Case {file}{}; projectile `{body}` (case impact speed {impact:.1} m/s{kind}); {jobs} runs side by side, {threads_per_run} thread(s) each; \
          produced by `plugsim ballistic` ({} {}) on {}.",
         if set.is_empty() { String::new() } else { format!(" with {}", set.join(" ")) },
         env!("CARGO_PKG_VERSION"),

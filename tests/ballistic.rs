@@ -1,7 +1,9 @@
 //! `plugsim ballistic` end to end on a small plate, and the residual
 //! velocity every run reports (`plugsim::residual`).
 
-use plugsim::ballistic::{find_limit, run_speeds, select_projectile, write_files, Event, Setup, Study};
+use plugsim::ballistic::{
+    at_rows, at_speed, find_limit, flight, run_speeds, select_projectile, write_files, Event, Projectile, Setup, Study,
+};
 use plugsim::case::Case;
 use plugsim::residual::Verdict;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -67,7 +69,7 @@ fn a_case_without_a_moving_rigid_body_is_refused_by_name() {
     let e = select_projectile(&case, "still.toml", None).unwrap_err().to_string();
     assert!(e.contains("still.toml") && e.contains("no rigid body with an initial velocity"), "{e}");
     let e = select_projectile(&case, "still.toml", Some("bullet")).unwrap_err().to_string();
-    assert!(e.contains("no rigid body named 'bullet'") && e.contains("projectile"), "{e}");
+    assert!(e.contains("no moving body named 'bullet'"), "{e}");
     let plain = Case::from_str_with(include_str!("../cases/elastic-strike.toml"), "elastic-strike", &[]).unwrap();
     let e = select_projectile(&plain, "elastic-strike", None).unwrap_err().to_string();
     assert!(e.contains("elastic-strike") && e.contains("(rigid bodies: none)"), "{e}");
@@ -184,4 +186,85 @@ fn the_command_runs_the_study_at_each_resolution() {
     assert!(!o.status.success() && stderr.contains("at least 2"), "{stderr}");
     assert!(!bad.exists(), "refused before any run");
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The small impact with the projectile as a deformable body of hard,
+/// elastic steel (issue #20): the same 8 mm × 20 mm rectangle at 400 m/s.
+fn small_plate_deformable_projectile() -> String {
+    let rigid = "[[rigid_bodies]]\nname = \"projectile\"\nrectangle = { center = [0.0, 0.01405], width = 0.008, height = 0.02 }\ndensity = 7850.0\nvelocity = [0.0, -400.0]\n";
+    let text = small_plate();
+    assert!(text.contains(rigid), "the shared case's projectile moved");
+    let deformable =
+        "[materials.hard]\nmodel = \"elastic\"\ndensity = 7850.0\nyoungs_modulus = 204.0e9\npoisson_ratio = 0.3\n\
+        [[bodies]]\nname = \"projectile\"\nmaterial = \"hard\"\n\
+        rectangle = { x_min = -0.004, x_max = 0.004, y_min = 0.00405, y_max = 0.02405, layers = 9 }\n\
+        [[bodies.initial_velocity]]\nvelocity = [0.0, -400.0]\n";
+    text.replace(rigid, deformable)
+}
+
+/// A deformable body flying as a whole is a projectile like a rigid one:
+/// chosen when it is the only moving body, its speed set by `at_speed`, and
+/// the study's `--rows` refine the target (not the projectile) to the
+/// rows asked, and the projectile by the same factor.
+#[test]
+fn a_deformable_projectile_is_selected_set_and_refined_with_its_target() {
+    let case = Case::from_str_with(&small_plate_deformable_projectile(), "soft", &[]).unwrap();
+    assert!(case.rigid_bodies.is_empty());
+    let p = select_projectile(&case, "soft", None).unwrap();
+    // the plate is body 0, the projectile body 1
+    assert_eq!(p, Projectile::Deformable(1));
+    assert_eq!(p.name(&case), "projectile");
+    let (dir, speed) = flight(&case, p);
+    assert_eq!((dir.x, dir.y, speed), (0.0, -1.0, 400.0));
+    let (fast, set) = at_speed(&case, p, 550.0);
+    assert_eq!(fast.bodies[1].initial_velocity[0].velocity, [0.0, -550.0]);
+    assert!(set.contains("bodies.projectile.initial_velocity") && set.contains("-550"), "{set}");
+    assert_eq!(fast.bodies[0].initial_velocity.len(), 0, "the plate does not move");
+    let (fine, set) = at_rows(&case, 18).unwrap();
+    assert_eq!((fine.bodies[0].rectangle.layers, fine.bodies[1].rectangle.layers), (18, 18));
+    assert!(set.iter().any(|s| s == "bodies.plate.rectangle.layers=18"), "{set:?}");
+    // Named: the deformable body, or a rigid one beside it.
+    assert_eq!(select_projectile(&case, "soft", Some("projectile")).unwrap(), p);
+    let two = small_plate_deformable_projectile()
+        + "[[rigid_bodies]]\nname = \"bullet\"\nrectangle = { center = [0.0, 0.05], width = 0.004, height = 0.004 }\n\
+           density = 7850.0\nvelocity = [0.0, -100.0]\n";
+    let two = Case::from_str_with(&two, "two", &[]).unwrap();
+    let e = select_projectile(&two, "two", None).unwrap_err().to_string();
+    assert!(e.contains("several moving bodies (bullet, projectile)"), "{e}");
+    assert_eq!(select_projectile(&two, "two", Some("bullet")).unwrap(), Projectile::Rigid(0));
+    assert_eq!(select_projectile(&two, "two", Some("projectile")).unwrap(), Projectile::Deformable(1));
+}
+
+/// A study with a deformable projectile runs, and each run's verdict is the
+/// deformable projectile's own flight (its mass-averaged velocity).
+#[test]
+fn a_study_fires_a_deformable_projectile() {
+    let case = Case::from_str_with(&small_plate_deformable_projectile(), "soft", &[]).unwrap();
+    let projectile = select_projectile(&case, "soft", None).unwrap();
+    let out_dir = std::env::temp_dir().join(format!("plugsim-ballistic-deformable-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out_dir);
+    std::fs::create_dir_all(&out_dir).unwrap();
+    let s = Setup {
+        case,
+        label: "soft".into(),
+        overrides: vec![],
+        projectile,
+        jobs: 1,
+        threads_per_run: 1,
+        out_dir: out_dir.clone(),
+        interrupt: None,
+    };
+    let mut study = Study::default();
+    run_speeds(&s, &[500.0], &mut study, &mut |_| Ok(()), &mut |_| {}).unwrap();
+    assert_eq!(study.shots.len(), 1, "{:?}", study.failures);
+    let shot = &study.shots[0];
+    let Verdict::Perforated { residual, .. } = shot.verdict else { panic!("{:?}", shot.verdict) };
+    // its own history: the deformable projectile's mass-averaged velocity
+    let history = plugsim::output::read_history(&shot.dir).unwrap();
+    let vy = history.column("projectile_vy").expect("the deformable projectile's velocity column");
+    assert!((residual + vy.last().unwrap()).abs() < 1e-9 * residual, "{residual} vs {}", vy.last().unwrap());
+    assert!(residual > 0.0 && residual < 500.0, "{residual}");
+    let info = std::fs::read_to_string(shot.dir.join("run_info.toml")).unwrap();
+    assert!(info.contains("bodies.projectile.initial_velocity"), "{info}");
+    std::fs::remove_dir_all(&out_dir).ok();
 }
