@@ -202,12 +202,20 @@ pub fn flight(case: &Case, projectile: Projectile) -> (Vec2, Real) {
     (crate::residual::flight_direction(v), v.norm())
 }
 
+/// The target of `case`: its first deformable body that does not fly as a
+/// whole (not a deformable projectile, [`Case::deformable_flights`]), by
+/// index; the body whose rows `--rows` counts.
+pub fn target(case: &Case) -> Option<usize> {
+    let flying: Vec<usize> = case.deformable_flights().into_iter().map(|(_, b, _)| b).collect();
+    (0..case.bodies.len()).find(|b| !flying.contains(b))
+}
+
 /// `case` refined uniformly so that its target — its first deformable body
 /// that does not fly as a whole (not a deformable projectile,
 /// [`Case::deformable_flights`]) — has `rows` particle rows through its
 /// thickness: every deformable body's `layers` (a deformable
-/// projectile's too) is multiplied by `k = rows / layers₀` (`layers₀` the
-/// target's), its
+/// projectile's too, rounded to the nearest whole number) is multiplied by
+/// `k = rows / layers₀` (`layers₀` the target's), its
 /// `fine_spacing` and `coarse_spacing` (where given) divided by `k`;
 /// nothing else changes (the fine zone's width and the grading ratio are
 /// geometry, `fracture.nonlocal_radius` and `band_width` material lengths,
@@ -217,8 +225,7 @@ pub fn flight(case: &Case, projectile: Projectile) -> (Vec2, Real) {
 /// at `k = 2` a built-in coarse Børvik case becomes its fine sibling.
 pub fn at_rows(case: &Case, rows: usize) -> Result<(Case, Vec<String>), BallisticError> {
     let flying: Vec<usize> = case.deformable_flights().into_iter().map(|(_, b, _)| b).collect();
-    let first = (0..case.bodies.len())
-        .find(|b| !flying.contains(b))
+    let first = target(case)
         .map(|b| &case.bodies[b])
         .ok_or_else(|| BallisticError::Settings("the case has no deformable target to refine".into()))?;
     if rows < 2 {
@@ -227,9 +234,13 @@ pub fn at_rows(case: &Case, rows: usize) -> Result<(Case, Vec<String>), Ballisti
     let k = rows as Real / first.rectangle.layers as Real;
     let mut c = case.clone();
     let mut set = Vec::new();
-    for b in &mut c.bodies {
+    for (index, b) in c.bodies.iter_mut().enumerate() {
         let r = &mut b.rectangle;
-        let layers = r.layers as Real * k;
+        let mut layers = r.layers as Real * k;
+        if flying.contains(&index) {
+            // a projectile's rows need not be exact: the nearest whole number
+            layers = layers.round().max(2.0);
+        }
         if (layers - layers.round()).abs() > 1e-9 || layers.round() < 2.0 {
             return Err(BallisticError::Settings(format!(
                 "--rows {rows}: body '{}' has {} rows where '{}' has {}, so it would get {layers:.3} (not a whole number of at least 2)",

@@ -592,7 +592,7 @@ fn ballistic(
     }
     let mut rungs = Vec::new();
     for (rows, (refined, extra)) in resolutions {
-        let body = &refined.bodies[0].rectangle;
+        let body = &refined.bodies[plugsim::ballistic::target(&refined).unwrap_or(0)].rectangle;
         let spacing = (body.y_max - body.y_min) / rows as f64;
         let dir = out_dir.join(format!("rows-{rows}"));
         eprintln!(

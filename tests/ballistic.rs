@@ -197,7 +197,7 @@ fn small_plate_deformable_projectile() -> String {
     let deformable =
         "[materials.hard]\nmodel = \"elastic\"\ndensity = 7850.0\nyoungs_modulus = 204.0e9\npoisson_ratio = 0.3\n\
         [[bodies]]\nname = \"projectile\"\nmaterial = \"hard\"\n\
-        rectangle = { x_min = -0.004, x_max = 0.004, y_min = 0.00405, y_max = 0.02405, layers = 9 }\n\
+        rectangle = { x_min = -0.004, x_max = 0.004, y_min = 0.00405, y_max = 0.02405, layers = 11 }\n\
         [[bodies.initial_velocity]]\nvelocity = [0.0, -400.0]\n";
     text.replace(rigid, deformable)
 }
@@ -205,7 +205,7 @@ fn small_plate_deformable_projectile() -> String {
 /// A deformable body flying as a whole is a projectile like a rigid one:
 /// chosen when it is the only moving body, its speed set by `at_speed`, and
 /// the study's `--rows` refine the target (not the projectile) to the
-/// rows asked, and the projectile by the same factor.
+/// rows asked, and the projectile by the same factor, rounded.
 #[test]
 fn a_deformable_projectile_is_selected_set_and_refined_with_its_target() {
     let case = Case::from_str_with(&small_plate_deformable_projectile(), "soft", &[]).unwrap();
@@ -221,8 +221,11 @@ fn a_deformable_projectile_is_selected_set_and_refined_with_its_target() {
     assert!(set.contains("bodies.projectile.initial_velocity") && set.contains("-550"), "{set}");
     assert_eq!(fast.bodies[0].initial_velocity.len(), 0, "the plate does not move");
     let (fine, set) = at_rows(&case, 18).unwrap();
-    assert_eq!((fine.bodies[0].rectangle.layers, fine.bodies[1].rectangle.layers), (18, 18));
+    assert_eq!((fine.bodies[0].rectangle.layers, fine.bodies[1].rectangle.layers), (18, 22));
     assert!(set.iter().any(|s| s == "bodies.plate.rectangle.layers=18"), "{set:?}");
+    // the target's rows exactly, the projectile's to the nearest whole number (11 x 12/9 = 14.7)
+    let (finer, _) = at_rows(&case, 12).unwrap();
+    assert_eq!((finer.bodies[0].rectangle.layers, finer.bodies[1].rectangle.layers), (12, 15));
     // Named: the deformable body, or a rigid one beside it.
     assert_eq!(select_projectile(&case, "soft", Some("projectile")).unwrap(), p);
     let two = small_plate_deformable_projectile()
