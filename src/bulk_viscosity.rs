@@ -12,7 +12,9 @@
 //!
 //! added to the pressure (`σ ← σ − q I`, `q > 0` in compression) in the
 //! internal force only: the material's own stress, plastic flow, heating and
-//! damage do not see it. The linear term is a damper of `b₁` of the critical
+//! damage do not see it. A point fractured by its damage
+//! (`crate::material::fractured`) keeps only the compressive part: it
+//! carries no tension, viscous or not. The linear term is a damper of `b₁` of the critical
 //! damping of the highest volumetric mode, in compression and expansion; the
 //! quadratic term acts in compression only and spreads a shock over a few
 //! lengths `L`. The form and the defaults `b₁ = 0.06`, `b₂ = 1.2` are those of

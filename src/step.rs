@@ -618,6 +618,8 @@ impl Simulation {
                 let length = current_length(lengths[qi], F_new.xx * F_new.yy - F_new.xy * F_new.yx);
                 let rate = d.trace();
                 let q = viscosity.pressure(mat.density() / J, mat.longitudinal_wave_speed(), length, rate);
+                // A fractured point carries no tension (`material::fractured`), viscous or not.
+                let q = if fracturing && new.damage >= 1.0 { q.max(0.0) } else { q };
                 force_tau = new_tau.sub(&Block2::identity_scaled(J * q));
                 c.work[k] -= J * q * rate * dt * w;
             }

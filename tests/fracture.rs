@@ -6,6 +6,7 @@
 
 mod common;
 
+use plugsim::bulk_viscosity::BulkViscosity;
 use plugsim::case::Case;
 use plugsim::contact::{SlaveSet, SurfaceDetection};
 use plugsim::fracture::growth::nodal_mass;
@@ -874,6 +875,37 @@ fn torn_fractured_points_are_eroded() {
     assert_eq!(eroded, all, "every point torn to J = 1.061 is eroded");
     assert_eq!(eroded_after_one_step(0.02, 1.2).0, 0, "J = 1.040: open, not torn");
     assert_eq!(eroded_after_one_step(0.03, 0.9).0, 0, "not fractured");
+}
+
+/// A fractured point carries no tension, viscous or not: in a plate
+/// dilating at a uniform rate with the bulk viscosity's linear damper on
+/// (which pulls back on any expanding point), points at `D ≥ 1` pass no
+/// force, while intact ones carry the damper's tension besides their own.
+#[test]
+fn fractured_points_carry_no_viscous_tension() {
+    let centre = Vec2::new(5.0 * H, 5.0 * H);
+    let force_stress_after_one_step = |damage: Real, viscosity: BulkViscosity| {
+        let mut m = plate(11, 11);
+        // expanding at 1e4 1/s from rest, J = 1
+        for i in 0..m.particles.len() {
+            m.particles.v[i] = (m.particles.x0[i] - centre) * 1.0e4;
+        }
+        m.quad.damage.fill(damage);
+        let mut sim = Simulation::new(m, TimeStepRule::Cfl { safety: 0.5 });
+        sim.bulk_viscosity = viscosity;
+        sim.cracks = Some(CrackGrowth::new(params(Criterion::Damage)));
+        sim.step().unwrap();
+        let q = &sim.model.quad;
+        (0..q.len()).map(|k| q.pw_block(k).trace() / q.weight[k]).fold(Real::NEG_INFINITY, Real::max)
+    };
+    let damper = BulkViscosity { linear: 0.5, quadratic: 0.0 };
+    assert_eq!(force_stress_after_one_step(1.2, damper), 0.0, "fractured: no tension");
+    let intact = force_stress_after_one_step(0.5, damper);
+    let bare = force_stress_after_one_step(0.5, BulkViscosity::NONE);
+    assert!(
+        bare > 0.0 && intact > 1.5 * bare,
+        "intact points in tension: {intact:e} with the damper, {bare:e} without"
+    );
 }
 
 /// The crack-tip speed limit of `"nonlocal_damage"` (`fracture::tip_speed`):
