@@ -129,12 +129,7 @@ impl Projectile {
     pub fn velocity(self, case: &Case) -> Vec2 {
         let v = match self {
             Projectile::Rigid(k) => case.rigid_bodies[k].velocity,
-            Projectile::Deformable(b) => case.bodies[b]
-                .initial_velocity
-                .iter()
-                .rev()
-                .find(|iv| iv.region.is_none())
-                .map_or([0.0; 2], |iv| iv.velocity),
+            Projectile::Deformable(b) => case.bodies[b].whole_body_velocity().unwrap_or([0.0; 2]),
         };
         Vec2::new(v[0], v[1])
     }
@@ -149,8 +144,8 @@ impl Projectile {
             }
             Projectile::Deformable(b) => {
                 let body = &mut case.bodies[b];
-                if let Some(iv) = body.initial_velocity.iter_mut().rev().find(|iv| iv.region.is_none()) {
-                    iv.velocity = v;
+                if let Some(velocity) = body.whole_body_velocity_mut() {
+                    *velocity = v;
                 }
                 format!("bodies.{}.initial_velocity (whole body) = {v:?}", body.name)
             }
@@ -206,8 +201,13 @@ pub fn flight(case: &Case, projectile: Projectile) -> (Vec2, Real) {
 /// whole (not a deformable projectile, [`Case::deformable_flights`]), by
 /// index; the body whose rows `--rows` counts.
 pub fn target(case: &Case) -> Option<usize> {
-    let flying: Vec<usize> = case.deformable_flights().into_iter().map(|(_, b, _)| b).collect();
+    let flying = flying_bodies(case);
     (0..case.bodies.len()).find(|b| !flying.contains(b))
+}
+
+/// The deformable projectiles of `case` by index among its bodies.
+fn flying_bodies(case: &Case) -> Vec<usize> {
+    case.deformable_flights().into_iter().map(|(_, b, _)| b).collect()
 }
 
 /// `case` refined uniformly so that its target — its first deformable body
@@ -224,7 +224,7 @@ pub fn target(case: &Case) -> Option<usize> {
 /// that give it from the original (for the report and to rerun one rung):
 /// at `k = 2` a built-in coarse Børvik case becomes its fine sibling.
 pub fn at_rows(case: &Case, rows: usize) -> Result<(Case, Vec<String>), BallisticError> {
-    let flying: Vec<usize> = case.deformable_flights().into_iter().map(|(_, b, _)| b).collect();
+    let flying = flying_bodies(case);
     let first = target(case)
         .map(|b| &case.bodies[b])
         .ok_or_else(|| BallisticError::Settings("the case has no deformable target to refine".into()))?;

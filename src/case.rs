@@ -121,6 +121,19 @@ pub struct BodySpec {
     pub supports: Vec<Support>,
 }
 
+impl BodySpec {
+    /// The velocity given over the whole body (the last `initial_velocity`
+    /// entry without a region), m/s: a deformable projectile's flight.
+    pub fn whole_body_velocity(&self) -> Option<[Real; 2]> {
+        self.initial_velocity.iter().rev().find(|iv| iv.region.is_none()).map(|iv| iv.velocity)
+    }
+
+    /// [`Self::whole_body_velocity`], to change it.
+    pub fn whole_body_velocity_mut(&mut self) -> Option<&mut [Real; 2]> {
+        self.initial_velocity.iter_mut().rev().find(|iv| iv.region.is_none()).map(|iv| &mut iv.velocity)
+    }
+}
+
 /// `[[bodies.initial_velocity]]`
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -947,7 +960,7 @@ impl Case {
             .iter()
             .enumerate()
             .filter_map(|(b, body)| {
-                let v = body.initial_velocity.iter().rev().find(|iv| iv.region.is_none())?.velocity;
+                let v = body.whole_body_velocity()?;
                 let v = Vec2::new(v[0], v[1]);
                 (v != Vec2::zeros()).then(|| (body.name.clone(), b, v))
             })

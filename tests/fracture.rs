@@ -847,6 +847,24 @@ fn inverted_failed_points_are_eroded_and_others_stop_the_run() {
     assert!((x - centre).norm() < 3.5 * H, "{x:?}");
 }
 
+/// An 11 × 11 plate stretched by `stretch` and dilating at `rate` (1/s)
+/// about its centre, every point at damage `damage`, with the damage
+/// criterion's cracks growing and `viscosity`, after one step.
+fn dilated_plate_after_one_step(stretch: Real, rate: Real, damage: Real, viscosity: BulkViscosity) -> Simulation {
+    let centre = Vec2::new(5.0 * H, 5.0 * H);
+    let mut m = plate(11, 11);
+    for i in 0..m.particles.len() {
+        m.particles.u[i] = (m.particles.x0[i] - centre) * stretch;
+        m.particles.v[i] = (m.particles.x0[i] - centre) * rate;
+    }
+    m.quad.damage.fill(damage);
+    let mut sim = Simulation::new(m, TimeStepRule::Cfl { safety: 0.5 });
+    sim.bulk_viscosity = viscosity;
+    sim.cracks = Some(CrackGrowth::new(params(Criterion::Damage)));
+    sim.step().unwrap();
+    sim
+}
+
 /// Fractured points (`D ≥ 1`, cracks growing) that are torn open beyond
 /// `TORN_VOLUME_RATIO` (`J ≥ 1.05`) are eroded: their deformation
 /// gradient no longer describes a continuum, and its `J` can swing toward
@@ -854,17 +872,9 @@ fn inverted_failed_points_are_eroded_and_others_stop_the_run() {
 /// fractured, they are not.
 #[test]
 fn torn_fractured_points_are_eroded() {
-    let centre = Vec2::new(5.0 * H, 5.0 * H);
     let eroded_after_one_step = |stretch: Real, damage: Real| {
-        let mut m = plate(11, 11);
         // A uniform dilation, J = (1 + stretch)², at rest.
-        for i in 0..m.particles.len() {
-            m.particles.u[i] = (m.particles.x0[i] - centre) * stretch;
-        }
-        m.quad.damage.fill(damage);
-        let mut sim = Simulation::new(m, TimeStepRule::Cfl { safety: 0.5 });
-        sim.cracks = Some(CrackGrowth::new(params(Criterion::Damage)));
-        sim.step().unwrap();
+        let sim = dilated_plate_after_one_step(stretch, 0.0, damage, BulkViscosity::NONE);
         let q = &sim.model.quad;
         let eroded = q.eroded.iter().filter(|&&e| e).count();
         assert!((0..q.len()).filter(|&k| q.eroded[k]).all(|k| q.tau[k] == Block2::zeros()));
@@ -883,18 +893,9 @@ fn torn_fractured_points_are_eroded() {
 /// force, while intact ones carry the damper's tension besides their own.
 #[test]
 fn fractured_points_carry_no_viscous_tension() {
-    let centre = Vec2::new(5.0 * H, 5.0 * H);
     let force_stress_after_one_step = |damage: Real, viscosity: BulkViscosity| {
-        let mut m = plate(11, 11);
         // expanding at 1e4 1/s from rest, J = 1
-        for i in 0..m.particles.len() {
-            m.particles.v[i] = (m.particles.x0[i] - centre) * 1.0e4;
-        }
-        m.quad.damage.fill(damage);
-        let mut sim = Simulation::new(m, TimeStepRule::Cfl { safety: 0.5 });
-        sim.bulk_viscosity = viscosity;
-        sim.cracks = Some(CrackGrowth::new(params(Criterion::Damage)));
-        sim.step().unwrap();
+        let sim = dilated_plate_after_one_step(0.0, 1.0e4, damage, viscosity);
         let q = &sim.model.quad;
         (0..q.len()).map(|k| q.pw_block(k).trace() / q.weight[k]).fold(Real::NEG_INFINITY, Real::max)
     };
