@@ -99,6 +99,14 @@ pub enum SolverError {
          likely cause: time step too large for the particle spacing, or a support too small"
     )]
     NonFinite { field: &'static str, location: &'static str, index: usize, step: u64, time: Real },
+    /// A finite temperature at or below 0 K: no update makes one, so an
+    /// unstable transfer has started (a growing one stays finite long
+    /// before it overflows).
+    #[error(
+        "temperature {temperature:.3e} K at quadrature point {point} in step {step} (t = {time:.6e} s), \
+         at or below absolute zero; likely cause: an unstable heat transfer"
+    )]
+    BelowAbsoluteZero { point: usize, temperature: Real, step: u64, time: Real },
     #[error(
         "deformation gradient inverted (J = {jacobian:.3e}) at quadrature point {point} \
          (X = ({x:.4e}, {y:.4e}) m) in step {step} (t = {time:.6e} s); likely cause: \
@@ -726,7 +734,10 @@ impl Simulation {
         let scalars_ok = (q.eps_p.par_chunks(piece), q.temperature.par_chunks(piece), q.damage.par_chunks(piece))
             .into_par_iter()
             .all(|(a, b, c)| {
-                a.iter().zip(b).zip(c).fold(true, |ok, ((a, b), c)| ok & a.is_finite() & b.is_finite() & c.is_finite())
+                a.iter()
+                    .zip(b)
+                    .zip(c)
+                    .fold(true, |ok, ((a, b), c)| ok & a.is_finite() & (*b > 0.0) & b.is_finite() & c.is_finite())
             });
         if healthy && scalars_ok {
             return Ok(());
@@ -744,6 +755,10 @@ impl Simulation {
         }
         if let Some(i) = p.f_int.par_iter().position_first(|f| !f.x.is_finite() || !f.y.is_finite()) {
             return Err(SolverError::NonFinite { field: "internal force", location: "particle", index: i, step, time });
+        }
+        if let Some(point) = q.temperature.par_iter().position_first(|t| *t <= 0.0) {
+            let temperature = q.temperature[point];
+            return Err(SolverError::BelowAbsoluteZero { point, temperature, step, time });
         }
         if let Some(i) = p.v.par_iter().position_first(|v| v.norm_squared() > bound2) {
             return Err(SolverError::Runaway {

@@ -453,6 +453,25 @@ fn heat_section_switches_conduction() {
     }
 }
 
+/// A temperature at or below absolute zero stops the run at once, naming
+/// the point, the step and the temperature: an unstable transfer stays
+/// finite long before it overflows, so a finiteness check alone lets it run
+/// on with garbage in the flow stress and the damage.
+#[test]
+fn a_temperature_below_absolute_zero_stops_the_run() {
+    let mut sim = build_simulation(&struck("").resolved()).unwrap();
+    for _ in 0..5 {
+        sim.step().unwrap();
+    }
+    sim.model.quad.temperature[17] = -3.0e13;
+    let err = sim.step().unwrap_err();
+    assert!(
+        matches!(err, plugsim::step::SolverError::BelowAbsoluteZero { point: 17, step: 6, temperature, .. } if temperature == -3.0e13),
+        "{err}"
+    );
+    assert!(err.to_string().contains("absolute zero") && err.to_string().contains("quadrature point 17"), "{err}");
+}
+
 /// The default follows the materials; asking for conduction with a material
 /// that cannot conduct, or a bad safety factor, is a problem naming the key.
 #[test]
