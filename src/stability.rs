@@ -54,6 +54,7 @@
 //!   new step alone, alternating steps pump the energy up until it blows
 //!   up).
 
+use crate::bulk_viscosity::step_factor;
 use crate::material::{Constitutive, Material};
 use crate::math::{Block2, Real, Vec2};
 use crate::model::{Model, PARALLEL_PIECE};
@@ -236,12 +237,18 @@ impl StableStep {
     }
 
     /// The stable step of `model` in its current configuration at `time`,
-    /// and the particle that sets it.
-    pub fn evaluate(&mut self, model: &Model, time: Real, fracturing: bool) -> Real {
+    /// with `damping_ratio` the largest damping ratio of the bulk viscosity
+    /// on a full lattice (0 without it; the step is then the elastic one bit
+    /// for bit), and the particle that sets it.
+    pub fn evaluate(&mut self, model: &Model, time: Real, fracturing: bool, damping_ratio: Real) -> Real {
         self.scratch.fill(model, true, fracturing);
         let (w2, i) = stiffest(&self.scratch.bounds);
         let w = w2.sqrt();
-        let dt = if w > self.reference && self.reference > 0.0 { self.base * (self.reference / w) } else { self.base };
+        let elastic =
+            if w > self.reference && self.reference > 0.0 { self.base * (self.reference / w) } else { self.base };
+        // A light particle's damping ratio grows with its frequency
+        // (`crate::bulk_viscosity`, "The stable step").
+        let dt = elastic * step_factor(damping_ratio * (self.base / elastic));
         if dt < self.smallest.0 {
             self.smallest = (dt, time, i);
         }

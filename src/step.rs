@@ -232,6 +232,11 @@ pub struct Simulation {
     /// default). Not in checkpoints: set from the case, as `heat`.
     #[serde(skip, default = "BulkViscosity::none")]
     pub bulk_viscosity: BulkViscosity,
+    /// The largest damping ratio of the bulk viscosity at the last material
+    /// update (0 without it), for the stable step. Not in checkpoints: every
+    /// step's material update sets it before the step is evaluated.
+    #[serde(skip)]
+    viscous_damping: Real,
     /// Some held (FIX_X / FIX_Y) component moves at a non-zero velocity:
     /// kinematic driving, whose work the energy account does not tally.
     pub driven_constraints: bool,
@@ -305,6 +310,7 @@ impl Simulation {
             contact: None,
             heat: None,
             bulk_viscosity: BulkViscosity::NONE,
+            viscous_damping: 0.0,
             heat_every: 1,
             heat_pending: 0.0,
             f_contact: vec![Vec2::zeros(); np],
@@ -421,7 +427,7 @@ impl Simulation {
         };
         let fracturing =
             self.cracks.as_ref().is_some_and(|c| c.params.critical_value().is_some() && c.params.fractures_points());
-        let dt = stable.evaluate(&self.model, self.time, fracturing);
+        let dt = stable.evaluate(&self.model, self.time, fracturing, self.viscous_damping);
         self.dt = dt;
     }
 
@@ -624,8 +630,9 @@ impl Simulation {
             if viscosity.is_active() {
                 let mat = &mats[body as usize];
                 let length = current_length(lengths[qi], F_new.xx * F_new.yy - F_new.xy * F_new.yx);
-                let rate = d.trace();
-                let q = viscosity.pressure(mat.density() / J, mat.longitudinal_wave_speed(), length, rate);
+                let (rate, wave_speed) = (d.trace(), mat.longitudinal_wave_speed());
+                c.damping = c.damping.max(viscosity.damping_ratio(wave_speed, length, rate));
+                let q = viscosity.pressure(mat.density() / J, wave_speed, length, rate);
                 // A fractured point carries no tension (`material::fractured`), viscous or not.
                 let q = if fracturing && new.damage >= 1.0 { q.max(0.0) } else { q };
                 force_tau = new_tau.sub(&Block2::identity_scaled(J * q));
@@ -643,7 +650,7 @@ impl Simulation {
         // bookkeeping took 8-10 % off the sweep on one thread). A piece
         // stops at its first inverted point, and the run stops there.
         let piece = PARALLEL_PIECE;
-        let bad = (
+        let (bad, damping) = (
             q.f.par_chunks_mut(piece),
             q.tau.par_chunks_mut(piece),
             q.eps_p.par_chunks_mut(piece),
@@ -672,11 +679,14 @@ impl Simulation {
                     work,
                     eroded,
                     carry,
+                    damping: 0.0,
                 };
-                (0..c.f.len()).find_map(|k| point(&mut c, k))
+                let bad = (0..c.f.len()).find_map(|k| point(&mut c, k));
+                (bad, c.damping)
             })
-            .find_first(Option::is_some)
-            .flatten();
+            // The first inverted point in index order, the largest ratio.
+            .reduce(|| (None, 0.0), |a, b| (a.0.or(b.0), a.1.max(b.1)));
+        self.viscous_damping = damping;
         if let Some((point, jacobian)) = bad {
             let x = self.model.quad.x0[point];
             return Err(SolverError::Inverted {
@@ -826,6 +836,8 @@ struct PieceColumns<'a> {
     work: &'a mut [Real],
     eroded: &'a mut [bool],
     carry: &'a [u32],
+    /// The largest damping ratio of the bulk viscosity in the piece.
+    damping: Real,
 }
 
 impl PieceColumns<'_> {

@@ -91,7 +91,7 @@
 
 use crate::material::Constitutive;
 use crate::math::{Real, Tensor3, Vec2};
-use crate::model::{Model, PARALLEL_PIECE};
+use crate::model::{Gather, Model, PARALLEL_PIECE};
 use crate::shape::ShapeTable;
 use nalgebra::Matrix2;
 use rayon::prelude::*;
@@ -274,14 +274,8 @@ impl HeatConduction {
     /// plane strain); `None` for a non-conducting body.
     pub fn capacity(&self, model: &Model, i: usize) -> Option<Real> {
         let t = self.body(model.particles.body[i])?;
-        let (tab, gather, w) = (&model.qp_shape, &model.gather, &model.quad.weight);
-        let sum: Real = gather
-            .range(i)
-            .map(|j| {
-                let q = gather.point[j] as usize;
-                transfer_weight(gather.value[j], positive_sum(tab, q)) * w[q]
-            })
-            .sum();
+        let tab = &model.qp_shape;
+        let sum = transfer_volume(&model.gather, &model.quad.weight, i, |q| positive_sum(tab, q));
         Some(t.density * t.specific_heat * sum)
     }
 
@@ -459,16 +453,7 @@ impl HeatConduction {
             .for_each(|(i, (c, b))| {
                 *c = match bodies.get(*b as usize).and_then(|t| t.as_ref()) {
                     None => 0.0,
-                    Some(t) => {
-                        let sum: Real = gather
-                            .range(i)
-                            .map(|j| {
-                                let q = gather.point[j] as usize;
-                                transfer_weight(gather.value[j], positive[q]) * w[q]
-                            })
-                            .sum();
-                        t.density * t.specific_heat * sum
-                    }
+                    Some(t) => t.density * t.specific_heat * transfer_volume(gather, w, i, |q| positive[q]),
                 };
             });
     }
@@ -663,6 +648,19 @@ pub fn transfer_weight(n: Real, positive_sum: Real) -> Real {
     } else {
         0.0
     }
+}
+
+/// `Σ_q φ_I(X_q) w_q` of particle `i` over its gather entries, given each
+/// point's `s_q` (`positive`): the volume a particle's capacity weighs.
+#[inline]
+fn transfer_volume(gather: &Gather, w: &[Real], i: usize, positive: impl Fn(usize) -> Real) -> Real {
+    gather
+        .range(i)
+        .map(|j| {
+            let q = gather.point[j] as usize;
+            transfer_weight(gather.value[j], positive(q)) * w[q]
+        })
+        .sum()
 }
 
 /// `s_q = Σ_J max(N_J(X_q), 0)` over point `q`'s row of `tab`.
