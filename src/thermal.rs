@@ -69,9 +69,10 @@
 //!   it (the round trip is per phase, not per sub-step). Found on Case I's
 //!   plate, 48 rows, `ℓ = 2 mm`, 150 m/s: one split particle's temperature
 //!   grew tenfold per µs from 44 µs, `−3·10¹³ K` at 44 µs and an overflow
-//!   at 97 µs; the 12 mm plate at 300 m/s at 48 rows (default model) ran
-//!   from 36 µs to its end with such temperatures; two of 190 stored
-//!   ballistic runs at 24 rows had them too. With `φ ≥ 0` the rows of
+//!   at 97 µs; six of ~250 stored runs had such temperatures, none before
+//!   the result that docs/validation.md reports was decided, except in one
+//!   run of a trial that was not kept (its section "Temperatures that grew
+//!   without bound after a crack split"). With `φ ≥ 0` the rows of
 //!   `M_L⁻¹ M_c` sum to 1 with no negative entry, so its eigenvalues lie in
 //!   `(0, 1]` and, with the sub-cycled Euler's factors in `[0, 1]`, a
 //!   phase cannot amplify anything. Conservation is untouched (it needs

@@ -55,7 +55,9 @@
 //!   the projectile (where the release converging on the axis pulls the
 //!   face), cut a half-millimetre core along the axis, threw a
 //!   1.3·10⁻⁸ kg child at 3140 m/s and stopped with unbounded
-//!   temperatures (`no_ring_crack_nucleates_within_the_averaging_length_of_the_axis`;
+//!   temperatures (those were the heat transfer's round trip amplifying at
+//!   light split children, since fixed: `crate::thermal`'s deviations)
+//!   (`no_ring_crack_nucleates_within_the_averaging_length_of_the_axis`;
 //!   docs/validation.md). \[RL10\]'s criteria keep their nucleation. The
 //!   failed-zone rule is what keeps the number of cracks independent of the
 //!   resolution: the distance rule counts spacings, and in the fine Borvik
