@@ -862,13 +862,7 @@ mod tests {
         assert!(after > 0.0 && after < 0.2 * before && consistent > 2.0 * after, "{before:e} {after:e} {consistent:e}");
         m.gather.copy_entries(&m.qp_shape);
         // masses lumped from the changed table, as a split re-lumps them
-        let mut mass = vec![0.0; m.particles.len()];
-        for q in 0..m.quad.len() {
-            for k in m.qp_shape.range(q) {
-                mass[m.qp_shape.index[k] as usize] += 2000.0 * m.qp_shape.value[k] * m.quad.weight[q];
-            }
-        }
-        m.particles.mass = mass;
+        m.lump_masses();
         let mut s = 11u64;
         for t in m.quad.temperature.iter_mut() {
             *t = 300.0 + 100.0 * lcg(&mut s);
