@@ -112,6 +112,11 @@ enum Command {
         /// Tolerance of the limit, +- m/s.
         #[arg(long, default_value_t = 1.0, requires = "limit")]
         tol: f64,
+        /// Let a run still undecided at the case's end time (the plate neither held the projectile
+        /// nor let it go) go on up to this simulated time, s (default: 3 times the case's end time;
+        /// the case's end time to stop there).
+        #[arg(long)]
+        max_time: Option<f64>,
         /// The body to fire, rigid or deformable (default: the case's only moving one).
         #[arg(long)]
         projectile: Option<String>,
@@ -272,6 +277,7 @@ fn dispatch(cmd: Command) -> Result<()> {
             lo,
             hi,
             tol,
+            max_time,
             projectile,
             jobs,
             set,
@@ -280,7 +286,7 @@ fn dispatch(cmd: Command) -> Result<()> {
             rows,
         } => {
             let (case, name, file) = load(&case_file, &case, &set)?;
-            let args = BallisticArgs { speeds, limit, lo, hi, tol, projectile, jobs, experiments, rows };
+            let args = BallisticArgs { speeds, limit, lo, hi, tol, max_time, projectile, jobs, experiments, rows };
             ballistic(case, &name, &file, &set, out, args)
         }
         Command::Bench { case, steps, whole, set } => bench(&case, steps, whole, &set),
@@ -555,6 +561,7 @@ struct BallisticArgs {
     lo: Option<f64>,
     hi: Option<f64>,
     tol: f64,
+    max_time: Option<f64>,
     projectile: Option<String>,
     jobs: Option<usize>,
     experiments: Option<PathBuf>,
@@ -576,6 +583,14 @@ fn ballistic(
     }
     if let Some(v) = args.speeds.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
         bail!("impact speeds must be positive numbers (got {v})");
+    }
+    if let Some(t) = args.max_time {
+        if !(t.is_finite() && t >= case.time.end) {
+            bail!(
+                "--max-time must be at least the case's end time, {:e} s (got {t:e}); shorten a case with --set time.end=...",
+                case.time.end
+            );
+        }
     }
     // Every resolution is checked before the first run starts.
     let resolutions = args.rows.iter().map(|&r| Ok((r, at_rows(&case, r)?))).collect::<Result<Vec<_>>>()?;
@@ -656,6 +671,7 @@ fn one_study(
     let cores = rayon::current_num_threads().max(1);
     let jobs = args.jobs.unwrap_or(cores).max(1);
     let threads_per_run = (cores / jobs).max(1);
+    let max_time = args.max_time.unwrap_or_else(|| plugsim::ballistic::default_max_time(&case));
     std::fs::create_dir_all(out_dir).with_context(|| format!("cannot create {}", out_dir.display()))?;
     let setup = Setup {
         case,
@@ -665,6 +681,7 @@ fn one_study(
         jobs,
         threads_per_run,
         out_dir: out_dir.to_path_buf(),
+        max_time,
         interrupt: interrupt.clone(),
     };
     let body = projectile.name(&setup.case);

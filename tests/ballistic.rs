@@ -33,6 +33,7 @@ fn setup(name: &str, jobs: usize) -> Setup {
         jobs,
         threads_per_run: 1,
         out_dir,
+        max_time: 100.0e-6,
         interrupt: None,
     }
 }
@@ -122,6 +123,33 @@ fn speeds_run_side_by_side_and_the_limit_is_bracketed() {
     std::fs::remove_dir_all(&s.out_dir).ok();
 }
 
+/// A run the plate has neither held nor let go at the case's end time goes
+/// on, up to the study's max time, and stops once decided; with the max
+/// time at the end time it stops undecided there, as before.
+#[test]
+fn a_run_undecided_at_the_end_time_goes_on_until_decided() {
+    let mut s = setup("decide", 1);
+    s.case.time.end = 6.0e-6; // the projectile is still in the plate
+    s.max_time = s.case.time.end;
+    let mut study = Study::default();
+    run_speeds(&s, &[300.0], &mut study, &mut |_| Ok(()), &mut |_| {}).unwrap();
+    let cut = &study.shots[0];
+    assert!(matches!(cut.verdict, Verdict::Undecided { .. }), "{:?}", cut.verdict);
+    assert!((cut.end_time - 6.0e-6).abs() < 0.1e-6, "{}", cut.end_time);
+    s.max_time = 100.0e-6;
+    let mut study = Study::default();
+    run_speeds(&s, &[300.0], &mut study, &mut |_| Ok(()), &mut |_| {}).unwrap();
+    let shot = &study.shots[0];
+    let Verdict::Perforated { residual, since } = shot.verdict else { panic!("{:?}", shot.verdict) };
+    assert!(residual > 0.0 && residual < 300.0, "{residual}");
+    // stopped by the early stop (2 us after the release), not at the max time
+    assert!(shot.end_time > 6.0e-6 && shot.end_time < 100.0e-6, "{}", shot.end_time);
+    assert!(shot.end_time >= since + 2.0e-6, "{} {since}", shot.end_time);
+    let info = std::fs::read_to_string(shot.dir.join("run_info.toml")).unwrap();
+    assert!(info.contains("time.end=1e-4"), "the run's provenance records the longer end: {info}");
+    std::fs::remove_dir_all(&s.out_dir).ok();
+}
+
 /// An interrupt after the first run keeps that run in the table and stops
 /// the rest.
 #[test]
@@ -185,6 +213,11 @@ fn the_command_runs_the_study_at_each_resolution() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && stderr.contains("at least 2"), "{stderr}");
     assert!(!bad.exists(), "refused before any run");
+    // A max time before the case's end time is refused, naming the option.
+    let o = plugsim(&["--speeds", "500", "--max-time", "1e-6", "--out", bad.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && stderr.contains("--max-time must be at least"), "{stderr}");
+    assert!(!bad.exists(), "refused before any run");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -216,9 +249,13 @@ fn a_deformable_projectile_is_selected_set_and_refined_with_its_target() {
     assert_eq!(p.name(&case), "projectile");
     let (dir, speed) = flight(&case, p);
     assert_eq!((dir.x, dir.y, speed), (0.0, -1.0, 400.0));
-    let (fast, set) = at_speed(&case, p, 550.0);
+    let (fast, set) = at_speed(&case, p, 550.0, 0.0);
     assert_eq!(fast.bodies[1].initial_velocity[0].velocity, [0.0, -550.0]);
-    assert!(set.contains("bodies.projectile.initial_velocity") && set.contains("-550"), "{set}");
+    assert!(
+        set.len() == 1 && set[0].contains("bodies.projectile.initial_velocity") && set[0].contains("-550"),
+        "{set:?}"
+    );
+    assert_eq!(fast.time.end, case.time.end, "a max time before the end time shortens nothing");
     assert_eq!(fast.bodies[0].initial_velocity.len(), 0, "the plate does not move");
     let (fine, set) = at_rows(&case, 18).unwrap();
     assert_eq!((fine.bodies[0].rectangle.layers, fine.bodies[1].rectangle.layers), (18, 22));
@@ -255,6 +292,7 @@ fn a_study_fires_a_deformable_projectile() {
         jobs: 1,
         threads_per_run: 1,
         out_dir: out_dir.clone(),
+        max_time: 0.0,
         interrupt: None,
     };
     let mut study = Study::default();
