@@ -227,6 +227,10 @@ pub struct ProjectileSpec {
     /// diameter, ≥ 0.5 (0.5 is the hemisphere); nose length `R √(4ψ − 1)`.
     #[serde(default)]
     pub caliber_radius_head: Option<Real>,
+    /// Blunt only: radius of the quarter circle that rounds the flat face's
+    /// edge onto the shank, m, in [0, D/2) (default 0: a sharp edge).
+    #[serde(default)]
+    pub edge_radius: Option<Real>,
 }
 
 /// The nose shapes of [`ProjectileSpec`].
@@ -244,7 +248,7 @@ impl ProjectileSpec {
     /// out of range (see [`ProjectileSpec::problems`]).
     pub fn projectile(&self) -> Option<Projectile> {
         let nose = match self.nose {
-            NoseKind::Blunt => NoseShape::Blunt,
+            NoseKind::Blunt => NoseShape::Blunt { edge_radius: self.edge_radius.unwrap_or(0.0) },
             NoseKind::Hemispherical => NoseShape::Hemispherical,
             NoseKind::Conical => NoseShape::Conical {
                 nose_length: match (self.nose_length, self.nose_angle_deg) {
@@ -280,7 +284,9 @@ impl ProjectileSpec {
         }
         let conical = self.nose == NoseKind::Conical;
         let ogival = self.nose == NoseKind::Ogival;
+        let blunt = self.nose == NoseKind::Blunt;
         for (field, given, applies, owner) in [
+            ("edge_radius", self.edge_radius.is_some(), blunt, "blunt"),
             ("nose_length", self.nose_length.is_some(), conical, "conical"),
             ("nose_angle_deg", self.nose_angle_deg.is_some(), conical, "conical"),
             ("caliber_radius_head", self.caliber_radius_head.is_some(), ogival, "ogival"),
@@ -304,6 +310,17 @@ impl ProjectileSpec {
                     p.push(("nose_angle_deg", format!("must lie in (0, 180) degrees, got {a}")))
                 }
                 _ => {}
+            }
+        }
+        if let (true, Some(e)) = (blunt, self.edge_radius) {
+            if !(e.is_finite() && e >= 0.0 && e < 0.5 * self.diameter) {
+                p.push((
+                    "edge_radius",
+                    format!(
+                        "must lie in [0, diameter/2) m (diameter/2 is the hemispherical nose), got {e} with diameter {}",
+                        self.diameter
+                    ),
+                ));
             }
         }
         if ogival {

@@ -55,6 +55,17 @@ fn every_nose_builds_its_body_with_the_mass_of_its_solid() {
     let (r, l) = (0.005, 0.01);
     for (nose, extra, nose_volume, nose_area, nose_length) in [
         ("blunt", "", 0.0, 0.0, 0.0),
+        // a 1 mm edge radius: the face's disc and a quarter-circle ring
+        // (Pappus: the quarter disc's centroid at R − e + 4e/3π from the axis)
+        (
+            "blunt",
+            ", edge_radius = 0.001",
+            pi * ((r - 0.001) * (r - 0.001) * 0.001
+                + 0.5 * pi * (r - 0.001) * 0.001 * 0.001
+                + 2.0 / 3.0 * 0.001 * 0.001 * 0.001),
+            2.0 * ((r - 0.001) * 0.001 + 0.25 * pi * 0.001 * 0.001),
+            0.001,
+        ),
         ("hemispherical", "", 2.0 / 3.0 * pi * r * r * r, 0.5 * pi * r * r, r),
         ("conical", ", nose_angle_deg = 90.0", pi * r * r * r / 3.0, r * r, r),
         ("conical", ", nose_length = 0.004", pi * r * r * 0.004 / 3.0, r * 0.004, 0.004),
@@ -110,6 +121,14 @@ fn wrong_nose_parameters_are_named() {
         ),
         (r#"{ nose = "hemispherical", tip = [0.0, 0.007], diameter = 0.01, length = 0.004 }"#, "projectile.length"),
         (r#"{ nose = "blunt", tip = [0.0, 0.007], diameter = -0.01, length = 0.01 }"#, "projectile.diameter"),
+        (
+            r#"{ nose = "blunt", tip = [0.0, 0.007], diameter = 0.01, length = 0.01, edge_radius = 0.005 }"#,
+            "projectile.edge_radius",
+        ),
+        (
+            r#"{ nose = "conical", tip = [0.0, 0.007], diameter = 0.01, length = 0.01, nose_length = 0.002, edge_radius = 0.001 }"#,
+            "applies to blunt noses only",
+        ),
         (r#"{ nose = "ogive", tip = [0.0, 0.007], diameter = 0.01, length = 0.01 }"#, "ogival"),
         (r#"{ nose = "blunt", tip = [0.0, 0.007], diameter = 0.01, length = 0.01, angle = 3 }"#, "angle"),
     ];

@@ -3,7 +3,10 @@
 //!
 //! A projectile is a cylinder of diameter `D = 2R` and overall length `L`
 //! (tip to back face) ending in a nose of length `L_n < L`:
-//! - blunt: a flat face, `L_n = 0`;
+//! - blunt: a flat face, `L_n = 0`; or a flat face whose edge is rounded
+//!   by a quarter circle of radius `r_e < R` onto the shank, `L_n = r_e`
+//!   (machined projectiles have one; a rigid sharp edge is a corner the
+//!   plate's strain concentrates at more, the finer its particles);
 //! - hemispherical: a half sphere of the shank's radius, `L_n = R`;
 //! - conical: a cone of length `L_n` (or of included apex angle `α`,
 //!   `L_n = R / tan(α/2)`), sharp at the tip;
@@ -56,8 +59,9 @@ pub const FACET_PER_SPACING: Real = 0.25;
 /// A nose shape with its parameters resolved (module doc).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum NoseShape {
-    /// Flat face.
-    Blunt,
+    /// Flat face, its edge rounded onto the shank by a quarter circle of
+    /// this radius, m (0: a sharp edge).
+    Blunt { edge_radius: Real },
     /// Half sphere of the shank's radius.
     Hemispherical,
     /// Cone of this length, m.
@@ -104,20 +108,27 @@ impl Projectile {
     pub fn nose_length(&self) -> Real {
         let r = self.radius();
         match self.nose {
-            NoseShape::Blunt => 0.0,
+            NoseShape::Blunt { edge_radius } => edge_radius,
             NoseShape::Hemispherical => r,
             NoseShape::Conical { nose_length } => nose_length,
             NoseShape::Ogival { caliber_radius_head } => r * (4.0 * caliber_radius_head - 1.0).sqrt(),
         }
     }
 
-    /// Radius of the curved nose's arcs, m (`None` for flat and conical noses).
+    /// Radius of the curved nose's arcs, m (`None` for a sharp-edged flat
+    /// nose and for conical ones).
     pub fn arc_radius(&self) -> Option<Real> {
         match self.nose {
             NoseShape::Hemispherical => Some(self.radius()),
             NoseShape::Ogival { caliber_radius_head } => Some(caliber_radius_head * self.diameter),
-            NoseShape::Blunt | NoseShape::Conical { .. } => None,
+            NoseShape::Blunt { edge_radius } if edge_radius > 0.0 => Some(edge_radius),
+            NoseShape::Blunt { .. } | NoseShape::Conical { .. } => None,
         }
+    }
+
+    /// Whether the nose has a flat face through the axis (blunt).
+    pub fn is_flat(&self) -> bool {
+        matches!(self.nose, NoseShape::Blunt { .. })
     }
 
     /// The right half of the section (`x ≥ 0`), from the tip on the axis
@@ -141,15 +152,24 @@ impl Projectile {
             }
             Some(rho) => {
                 // Arc centred at (R − ρ, L_n) from the tip (angle −θ) to the
-                // shoulder (angle 0), where it meets the shank tangentially.
+                // shoulder (angle 0), where it meets the shank tangentially;
+                // a rounded flat face runs from the axis to the arc's start
+                // (R − r_e, 0), the arc a quarter circle (θ = 90°).
                 let centre = Vec2::new(r - rho, ln);
+                if self.is_flat() {
+                    p.push(Vec2::zeros());
+                }
                 let theta = (ln / rho).clamp(-1.0, 1.0).asin();
                 let by_length = (rho * theta / facet).ceil();
                 let by_turn = (theta / MAX_FACET_TURN_DEG.to_radians()).ceil();
                 let n = by_length.max(by_turn).clamp(1.0, MAX_ARC_FACETS) as usize;
                 for k in 0..=n {
                     let a = -theta * (1.0 - k as Real / n as Real);
-                    p.push(if k == 0 { Vec2::zeros() } else { centre + Vec2::new(a.cos(), a.sin()) * rho });
+                    p.push(match k {
+                        0 if self.is_flat() => Vec2::new(r - rho, 0.0),
+                        0 => Vec2::zeros(),
+                        _ => centre + Vec2::new(a.cos(), a.sin()) * rho,
+                    });
                 }
                 // the shoulder exactly (no round-off off the shank line)
                 *p.last_mut().expect("n >= 1") = Vec2::new(r, ln);
@@ -169,7 +189,7 @@ impl Projectile {
         // rim closes the face).
         o.extend(half.iter().rev().filter(|v| v.x != 0.0).map(|v| Vec2::new(-v.x, v.y)));
         // The blunt face's axis point lies inside the face segment: drop it.
-        if self.nose == NoseShape::Blunt {
+        if self.is_flat() {
             o.remove(0);
         }
         o
@@ -188,7 +208,8 @@ mod tests {
 
     fn shapes() -> Vec<Projectile> {
         [
-            NoseShape::Blunt,
+            NoseShape::Blunt { edge_radius: 0.0 },
+            NoseShape::Blunt { edge_radius: 0.1 * D },
             NoseShape::Hemispherical,
             NoseShape::Conical { nose_length: cone_length(0.5 * D, 60.0) },
             NoseShape::Ogival { caliber_radius_head: 3.0 },
@@ -205,8 +226,39 @@ mod tests {
     fn exact(p: &Projectile) -> (Real, Real, Real, Real) {
         let (r, l, ln) = (p.radius(), p.length, p.nose_length());
         // nose: (half area, half ∫ y dA, volume, ∫ y dV)
+        // (half area, ∫ y dA over the half, volume, ∫ y dV) of a nose of
+        // radius profile f over [0, L_n], by Simpson's rule (fine enough to
+        // be exact to 1e-7 even where f has a vertical tangent).
+        let simpson = |f: &dyn Fn(Real) -> Real| {
+            let n = 200_000;
+            let mut sums = [0.0; 4];
+            for k in 0..=n {
+                let y = ln * k as Real / n as Real;
+                let w = if k == 0 || k == n {
+                    1.0
+                } else if k % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
+                let r = f(y);
+                for (s, term) in sums.iter_mut().zip([r, y * r, PI * r * r, y * PI * r * r]) {
+                    *s += w * term;
+                }
+            }
+            sums.map(|s| s * ln / n as Real / 3.0)
+        };
         let (a, ay, v, vy) = match p.nose {
-            NoseShape::Blunt => (0.0, 0.0, 0.0, 0.0),
+            NoseShape::Blunt { edge_radius: 0.0 } => (0.0, 0.0, 0.0, 0.0),
+            NoseShape::Blunt { edge_radius: e } => {
+                // r(y) = R − e + √(e² − (e − y)²); area and volume in closed
+                // form (a quarter disc; Pappus), the moments by Simpson.
+                let f = |y: Real| r - e + (e * e - (e - y).powi(2)).max(0.0).sqrt();
+                let [_, ay, _, vy] = simpson(&f);
+                let a = (r - e) * e + 0.25 * PI * e * e;
+                let v = PI * ((r - e).powi(2) * e + 0.5 * PI * (r - e) * e * e + 2.0 / 3.0 * e.powi(3));
+                (a, ay, v, vy)
+            }
             NoseShape::Hemispherical => (
                 0.25 * PI * r * r,
                 0.25 * PI * r * r * (r - 4.0 * r / (3.0 * PI)),
@@ -223,25 +275,10 @@ mod tests {
                 let t = (ln / rho).asin();
                 let a = 0.5 * rho * rho * t - 0.5 * ln * c;
                 let v = PI * (rho * rho * ln - ln.powi(3) / 3.0 - c * rho * rho * t);
-                // first moments by Simpson on the analytic profile (fine enough
-                // to be exact to round-off for this smooth integrand)
-                let n = 20_000;
+                // first moments by Simpson on the analytic profile
                 let f = |y: Real| ((rho * rho - (ln - y).powi(2)).max(0.0)).sqrt() - c;
-                let (mut ay, mut vy) = (0.0, 0.0);
-                for k in 0..=n {
-                    let y = ln * k as Real / n as Real;
-                    let w = if k == 0 || k == n {
-                        1.0
-                    } else if k % 2 == 1 {
-                        4.0
-                    } else {
-                        2.0
-                    };
-                    ay += w * y * f(y);
-                    vy += w * y * PI * f(y).powi(2);
-                }
-                let step = ln / n as Real / 3.0;
-                (a, ay * step, v, vy * step)
+                let [_, ay, _, vy] = simpson(&f);
+                (a, ay, v, vy)
             }
         };
         let shank = l - ln;
@@ -297,7 +334,7 @@ mod tests {
             for v in &o {
                 assert!(o.iter().any(|w| (w - Vec2::new(-v.x, v.y)).norm() < 1e-15), "{p:?}: not symmetric at {v:?}");
             }
-            if p.nose != NoseShape::Blunt {
+            if !p.is_flat() {
                 // the tip is a vertex with the exact normal −y
                 let k = o.iter().position(|v| v.norm() == 0.0).unwrap();
                 assert!((body.vertex_normal(k) - Vec2::new(0.0, -1.0)).norm() < 1e-12, "{p:?}");
@@ -305,7 +342,8 @@ mod tests {
             // facets within the rule: length ≤ h/4 and turn ≤ 2° on the curved noses
             if let Some(rho) = p.arc_radius() {
                 let half = p.profile(nose_segment_length(H));
-                let arc = &half[..half.len() - 1];
+                // the arc: not the shank, nor a rounded flat face
+                let arc = &half[usize::from(p.is_flat())..half.len() - 1];
                 for w in arc.windows(2) {
                     let s = (w[1] - w[0]).norm();
                     assert!(s <= nose_segment_length(H) * (1.0 + 1e-12), "{p:?}: facet {s}");
@@ -348,7 +386,7 @@ mod tests {
     #[test]
     fn contact_normal_and_gap_follow_the_analytic_nose() {
         let s = nose_segment_length(H);
-        for p in shapes().into_iter().filter(|p| p.nose != NoseShape::Blunt) {
+        for p in shapes().into_iter().filter(|p| p.nose != NoseShape::Blunt { edge_radius: 0.0 }) {
             let body = RigidBody::new("p", p.outline(s), Vec2::zeros(), Vec2::zeros(), 1.0).unwrap();
             let (r, ln) = (p.radius(), p.nose_length());
             let mut checked = 0;
@@ -392,7 +430,8 @@ mod tests {
     fn nose_lengths() {
         let r = 0.5 * D;
         let len = |nose| Projectile { diameter: D, length: L, nose }.nose_length();
-        assert_eq!(len(NoseShape::Blunt), 0.0);
+        assert_eq!(len(NoseShape::Blunt { edge_radius: 0.0 }), 0.0);
+        assert_eq!(len(NoseShape::Blunt { edge_radius: 0.001 }), 0.001);
         assert_eq!(len(NoseShape::Hemispherical), r);
         assert!((cone_length(r, 90.0) - r).abs() < 1e-15);
         assert!((len(NoseShape::Ogival { caliber_radius_head: 3.0 }) - r * 11f64.sqrt()).abs() < 1e-15);
