@@ -18,7 +18,7 @@
 //!   goes on, up to [`Setup::max_time`] (by default [`DECIDE_FACTOR`]
 //!   times the case's end time, [`default_max_time`]); the early stop ends
 //!   it 20 µs after the plate held it or released it. Near the limit a
-//!   slow plug is still being pushed at the end time [RL10] simulated (the
+//!   slow plug is still being pushed at the end time \[RL10\] simulated (the
 //!   Case I plate at 12 / 24 / 48 rows: every run counted held next to the
 //!   limit still moved at 7–16 m/s at 118 µs), so the limit within the
 //!   case's end time is not the ballistic limit; docs/validation.md
