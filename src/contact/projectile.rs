@@ -5,8 +5,8 @@
 //! (tip to back face) ending in a nose of length `L_n < L`:
 //! - blunt: a flat face, `L_n = 0`; or a flat face whose edge is rounded
 //!   by a quarter circle of radius `r_e < R` onto the shank, `L_n = r_e`
-//!   (machined projectiles have one; a rigid sharp edge is a corner the
-//!   plate's strain concentrates at more, the finer its particles);
+//!   (machined projectiles have one; docs/validation.md, "A rounded
+//!   projectile edge", measures what it does to the ballistic limits);
 //! - hemispherical: a half sphere of the shank's radius, `L_n = R`;
 //! - conical: a cone of length `L_n` (or of included apex angle `α`,
 //!   `L_n = R / tan(α/2)`), sharp at the tip;
