@@ -416,7 +416,9 @@ impl OutputWriter {
     /// of [`crate::residual`] held for `wait` (s): stopped or moving back, or
     /// free of force along its flight with a plug cut out (both for `wait`:
     /// the plug, thrown ahead, may still be caught again). Call
-    /// after every step (`time.stop_after_release`); false without a
+    /// at the steps the history records, so that it and the verdict read
+    /// from the history sample the same states (`time.stop_after_release`,
+    /// [`crate::run`]); false without a
     /// moving body (a rigid one with an initial velocity, not prescribed, or
     /// a deformable projectile).
     pub fn flights_over(&mut self, sim: &Simulation, wait: Real) -> bool {

@@ -112,6 +112,13 @@ fn speeds_run_side_by_side_and_the_limit_is_bracketed() {
     // The small plate's cracks run in material that still hardens, as in
     // the full-size plates (docs/validation.md).
     assert!(perforating.iter().all(|x| x.tip_hardening.is_some_and(|h| h > 0.0 && h.is_finite())), "{:?}", study.shots);
+    // A run stopped early was stopped because it was decided: the early stop
+    // and the verdict read the same states (src/run.rs).
+    for x in &study.shots {
+        if x.end_time < 99.0e-6 {
+            assert!(!matches!(x.verdict, Verdict::Undecided { .. }), "stopped at {} s: {:?}", x.end_time, x.verdict);
+        }
+    }
     assert_eq!(writes, study.shots.len(), "the table is written after every run");
     let csv = std::fs::read_to_string(s.out_dir.join("ballistic.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + study.shots.len(), "{csv}");
