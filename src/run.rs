@@ -422,6 +422,8 @@ fn time_loop(
         case.output.plot_times.iter().cloned().filter(|&t| !outputs_done || t - 0.5 * sim.dt > sim.time).collect();
     plot_times.sort_by(|a, b| b.total_cmp(a));
     let mut released = false;
+    // The steps whose state the history records (and the early stop reads).
+    let records_history = |step: u64| step.is_multiple_of(case.output.history_every);
     loop {
         let done = released || sim.time >= end - 0.5 * sim.dt;
         if !outputs_done {
@@ -431,7 +433,7 @@ fn time_loop(
                 schedule.next_snapshot += interval;
                 output_wall += t.elapsed();
             }
-            if sim.step.is_multiple_of(case.output.history_every) || done {
+            if records_history(sim.step) || done {
                 let t = Instant::now();
                 out.history_row(&sim)?;
                 schedule.max_drift = schedule.max_drift.max(sim.energies.drift().abs());
@@ -488,7 +490,7 @@ fn time_loop(
         // with it, and a run stopped as released read "in contact at the
         // end" (Case II, 24 rows, bulk viscosity, at 72.8 us).
         if let Some(wait) = case.time.stop_after_release {
-            if sim.step.is_multiple_of(case.output.history_every) {
+            if records_history(sim.step) {
                 released = out.flights_over(&sim, wait);
             }
         }

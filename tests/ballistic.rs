@@ -220,6 +220,11 @@ fn the_command_runs_the_study_at_each_resolution() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && stderr.contains("at least 2"), "{stderr}");
     assert!(!bad.exists(), "refused before any run");
+    // The option's help states the default the library uses.
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_plugsim")).args(["ballistic", "--help"]).output().unwrap();
+    let help = String::from_utf8_lossy(&o.stdout);
+    let default = format!("default: {} times the case's end time", plugsim::ballistic::DECIDE_FACTOR);
+    assert!(help.contains(&default), "{help}");
     // A max time before the case's end time is refused, naming the option.
     let o = plugsim(&["--speeds", "500", "--max-time", "1e-6", "--out", bad.to_str().unwrap()]);
     let stderr = String::from_utf8_lossy(&o.stderr);

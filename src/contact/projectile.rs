@@ -156,20 +156,19 @@ impl Projectile {
                 // a rounded flat face runs from the axis to the arc's start
                 // (R − r_e, 0), the arc a quarter circle (θ = 90°).
                 let centre = Vec2::new(r - rho, ln);
-                if self.is_flat() {
+                let start = if self.is_flat() {
                     p.push(Vec2::zeros());
-                }
+                    Vec2::new(r - rho, 0.0)
+                } else {
+                    Vec2::zeros()
+                };
                 let theta = (ln / rho).clamp(-1.0, 1.0).asin();
                 let by_length = (rho * theta / facet).ceil();
                 let by_turn = (theta / MAX_FACET_TURN_DEG.to_radians()).ceil();
                 let n = by_length.max(by_turn).clamp(1.0, MAX_ARC_FACETS) as usize;
                 for k in 0..=n {
                     let a = -theta * (1.0 - k as Real / n as Real);
-                    p.push(match k {
-                        0 if self.is_flat() => Vec2::new(r - rho, 0.0),
-                        0 => Vec2::zeros(),
-                        _ => centre + Vec2::new(a.cos(), a.sin()) * rho,
-                    });
+                    p.push(if k == 0 { start } else { centre + Vec2::new(a.cos(), a.sin()) * rho });
                 }
                 // the shoulder exactly (no round-off off the shank line)
                 *p.last_mut().expect("n >= 1") = Vec2::new(r, ln);
@@ -225,10 +224,9 @@ mod tests {
     /// `∫ y dV` in closed form.
     fn exact(p: &Projectile) -> (Real, Real, Real, Real) {
         let (r, l, ln) = (p.radius(), p.length, p.nose_length());
-        // nose: (half area, half ∫ y dA, volume, ∫ y dV)
-        // (half area, ∫ y dA over the half, volume, ∫ y dV) of a nose of
-        // radius profile f over [0, L_n], by Simpson's rule (fine enough to
-        // be exact to 1e-7 even where f has a vertical tangent).
+        // The same four of a nose of radius profile f over [0, L_n] by
+        // Simpson's rule (fine enough to be exact to 1e-7 even where f has a
+        // vertical tangent).
         let simpson = |f: &dyn Fn(Real) -> Real| {
             let n = 200_000;
             let mut sums = [0.0; 4];
@@ -248,6 +246,7 @@ mod tests {
             }
             sums.map(|s| s * ln / n as Real / 3.0)
         };
+        // nose: (half area, half ∫ y dA, volume, ∫ y dV)
         let (a, ay, v, vy) = match p.nose {
             NoseShape::Blunt { edge_radius: 0.0 } => (0.0, 0.0, 0.0, 0.0),
             NoseShape::Blunt { edge_radius: e } => {
