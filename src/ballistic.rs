@@ -43,8 +43,19 @@
 //! Runs go side by side on threads of their own, each with its own pool of
 //! worker threads (the solver's results do not depend on the thread count).
 //! The table is rewritten after every finished run, so an interrupt keeps
-//! every run finished before it. The library never prints: progress goes
-//! to a callback.
+//! every run finished before it, and each run in flight writes a
+//! checkpoint. The library never prints: progress goes to a callback.
+//!
+//! - **Resume** ([`Setup::resume`], `--resume`): the same study run again
+//!   into the same directory takes back every run that finished there
+//!   ([`SHOT_FILE`], [`finished_run`]) and continues every run an
+//!   interrupt stopped from its checkpoint (bit-identical to a run never
+//!   stopped, as `plugsim resume`), where the run's `case.resolved.toml` is
+//!   the one this study would run at that speed (same case, overrides,
+//!   resolution and max time); any other speed runs afresh. A limit search
+//!   resumed with the same bounds, tolerance and jobs asks for the same
+//!   speeds, so a 48-row search stopped after hours loses only the runs in
+//!   flight, and those only up to their checkpoint.
 
 use crate::case::Case;
 use crate::io::{IoError, LinePlot, PlotError, Series};
@@ -128,6 +139,11 @@ pub struct Setup {
     /// Set by Ctrl-C (or a test): runs in flight stop (each writes a
     /// checkpoint), no new run starts, the finished ones are kept.
     pub interrupt: Option<Arc<AtomicBool>>,
+    /// Continue a study in `out_dir` (`--resume`, module doc): a speed whose
+    /// run finished there with the same case is taken back, one
+    /// interrupted there continues from its checkpoint; without it every
+    /// speed runs afresh, over whatever its directory holds.
+    pub resume: bool,
 }
 
 /// The body a study fires.
@@ -304,8 +320,8 @@ pub fn at_speed(case: &Case, projectile: Projectile, speed: Real, max_time: Real
     (c, set)
 }
 
-/// One run of the study.
-#[derive(Clone, Debug, PartialEq)]
+/// One run of the study (a run's directory keeps it as [`SHOT_FILE`]).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Shot {
     /// Impact speed, m/s.
     pub speed: Real,
@@ -377,6 +393,13 @@ pub enum Event {
     Failed { speed: Real, message: String },
     /// A run stopped by the interrupt (its checkpoint is in its directory).
     Interrupted { speed: Real },
+    /// `--resume`: a run finished before with the same case, taken back
+    /// as it is (the table on disk includes it); `note` when another build
+    /// wrote it.
+    Reused { shot: Shot, note: Option<String> },
+    /// `--resume`: an interrupted run continues from its checkpoint at
+    /// `time` (s), with the checkpoint's warnings.
+    Resumed { speed: Real, time: Real, warnings: Vec<String> },
 }
 
 /// What a study found.
@@ -516,10 +539,33 @@ pub fn run_speeds(
     if todo.is_empty() || study.interrupted {
         return Ok(());
     }
-    let queue = Mutex::new(todo.into_iter().collect::<std::collections::VecDeque<Real>>());
+    let mut result = Ok(());
+    let mut take = |event: Event, study: &mut Study| {
+        match &event {
+            Event::Finished { shot } | Event::Reused { shot, .. } => {
+                study.shots.push(shot.clone());
+                study.shots.sort_by(|a, b| a.speed.total_cmp(&b.speed));
+                refit(study);
+                if result.is_ok() {
+                    result = report(study);
+                }
+            }
+            Event::Failed { speed, message } => study.failures.push((*speed, message.clone())),
+            Event::Interrupted { .. } => study.interrupted = true,
+            _ => {}
+        }
+        progress(event);
+    };
+    let mut queue = std::collections::VecDeque::new();
+    for speed in todo {
+        match setup.resume.then(|| finished_run(setup, speed)).flatten() {
+            Some((shot, note)) => take(Event::Reused { shot, note }, study),
+            None => queue.push_back(speed),
+        }
+    }
+    let queue = Mutex::new(queue);
     let stop = setup.interrupt.clone().unwrap_or_else(|| Arc::new(AtomicBool::new(false)));
     let (tx, rx) = mpsc::channel::<Event>();
-    let mut result = Ok(());
     std::thread::scope(|scope| {
         for _ in 0..setup.jobs.max(1) {
             let (tx, queue, stop) = (tx.clone(), &queue, stop.clone());
@@ -527,20 +573,7 @@ pub fn run_speeds(
         }
         drop(tx);
         for event in rx {
-            match &event {
-                Event::Finished { shot } => {
-                    study.shots.push(shot.clone());
-                    study.shots.sort_by(|a, b| a.speed.total_cmp(&b.speed));
-                    refit(study);
-                    if result.is_ok() {
-                        result = report(study);
-                    }
-                }
-                Event::Failed { speed, message } => study.failures.push((*speed, message.clone())),
-                Event::Interrupted { .. } => study.interrupted = true,
-                _ => {}
-            }
-            progress(event);
+            take(event, study);
         }
     });
     if stop.load(Ordering::SeqCst) {
@@ -584,7 +617,49 @@ pub fn run_dir(out_dir: &Path, speed: Real) -> PathBuf {
     out_dir.join(format!("v{speed:.2}"))
 }
 
-/// Run the case at `speed`; the event that ends it.
+/// The file in each run's directory that keeps its row of the table
+/// ([`Shot`]) and the build that wrote it, written when the run finishes:
+/// what `--resume` takes back ([`finished_run`]).
+pub const SHOT_FILE: &str = "shot.toml";
+
+/// What [`SHOT_FILE`] holds.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct FinishedRun {
+    /// [`crate::checkpoint::this_writer`] of the build that ran it.
+    writer: String,
+    shot: Shot,
+}
+
+/// Whether the run directory `dir` was started with the case this study
+/// runs at `speed`: its `case.resolved.toml` is the one
+/// [`at_speed`] gives, to the byte (every material constant, setting and
+/// the time it may run to).
+fn started_with_this_case(setup: &Setup, speed: Real, dir: &Path) -> bool {
+    let (case, _) = at_speed(&setup.case, setup.projectile, speed, setup.max_time);
+    std::fs::read_to_string(dir.join("case.resolved.toml")).is_ok_and(|text| text == case.resolved_toml())
+}
+
+/// `--resume`: the run at `speed` as it finished in the study's directory,
+/// if it finished there with the case this study runs at that speed
+/// (`None` otherwise: it runs again); with a note when another build wrote
+/// it (its result is that build's).
+pub fn finished_run(setup: &Setup, speed: Real) -> Option<(Shot, Option<String>)> {
+    let dir = run_dir(&setup.out_dir, speed);
+    if !started_with_this_case(setup, speed, &dir) {
+        return None;
+    }
+    let run: FinishedRun = toml::from_str(&std::fs::read_to_string(dir.join(SHOT_FILE)).ok()?).ok()?;
+    if run.shot.speed != speed {
+        return None;
+    }
+    let this = crate::checkpoint::this_writer();
+    let note = (run.writer != this).then(|| format!("written by {}, taken back by {this}", run.writer));
+    Some((Shot { dir, ..run.shot }, note))
+}
+
+/// Run the case at `speed` (with `--resume`, continue it from the
+/// checkpoint an interrupt left in its directory when that run had the same
+/// case); the event that ends it.
 fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender<Event>) -> Event {
     let t = std::time::Instant::now();
     let (case, set) = at_speed(&setup.case, setup.projectile, speed, setup.max_time);
@@ -596,34 +671,51 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
         ..RunConfig::new(dir.clone(), true, RunInfo::current(&setup.label, &overrides))
     };
     let mut next = 0.1;
-    let mut report = |p: Progress| {
-        if let Progress::Step { sim } = p {
+    let mut report = |p: Progress| match p {
+        Progress::Step { sim } => {
             let end = case.time.end;
             if sim.time >= next * end {
                 next = (sim.time / end * 10.0).floor() / 10.0 + 0.1;
                 let _ = tx.send(Event::Advanced { speed, time: sim.time, end });
             }
         }
+        Progress::Resumed { sim, warnings, .. } => {
+            next = (sim.time / case.time.end * 10.0).floor() / 10.0 + 0.1;
+            let _ = tx.send(Event::Resumed { speed, time: sim.time, warnings: warnings.to_vec() });
+        }
+        _ => {}
     };
-    match execute(&case, &cfg, &mut report) {
+    let interrupted = !crate::checkpoint::list(&crate::checkpoint::directory(&dir)).is_empty();
+    let result = if setup.resume && interrupted && started_with_this_case(setup, speed, &dir) {
+        crate::run::resume(&cfg, &mut report)
+    } else {
+        // a fresh run: no earlier result may stand for it
+        let _ = std::fs::remove_file(dir.join(SHOT_FILE));
+        execute(&case, &cfg, &mut report)
+    };
+    match result {
         Ok(s) => {
             let name = setup.projectile.name(&case);
             let verdict = s.flights.iter().find(|(n, _)| n == name).map_or(Verdict::NotMoving, |(_, v)| *v);
-            Event::Finished {
-                shot: Shot {
-                    speed,
-                    verdict,
-                    perforation: s.perforation,
-                    plug_mass: s.plug.as_ref().map(|p| p.mass),
-                    end_time: s.time,
-                    fastest: s.fastest.speed,
-                    tip_damage: s.tip_damage.map(|d| d.median),
-                    tip_hardening: s.tip_hardening.map(|h| h.min),
-                    steps: s.steps,
-                    wall: t.elapsed().as_secs_f64(),
-                    dir,
-                },
+            let shot = Shot {
+                speed,
+                verdict,
+                perforation: s.perforation,
+                plug_mass: s.plug.as_ref().map(|p| p.mass),
+                end_time: s.time,
+                fastest: s.fastest.speed,
+                tip_damage: s.tip_damage.map(|d| d.median),
+                tip_hardening: s.tip_hardening.map(|h| h.min),
+                steps: s.steps,
+                wall: t.elapsed().as_secs_f64(),
+                dir,
+            };
+            let kept = FinishedRun { writer: crate::checkpoint::this_writer(), shot: shot.clone() };
+            // Not written (a full disk): `--resume` runs it again; the table has it.
+            if let Ok(text) = toml::to_string(&kept) {
+                let _ = std::fs::write(shot.dir.join(SHOT_FILE), text);
             }
+            Event::Finished { shot }
         }
         Err(RunError::Interrupted { .. }) => Event::Interrupted { speed },
         Err(e) => Event::Failed { speed, message: e.to_string() },

@@ -139,6 +139,12 @@ enum Command {
         /// limit and the residuals side by side and their spread.
         #[arg(long, value_delimiter = ',')]
         rows: Vec<usize>,
+        /// Continue a study in --out: a speed whose run finished there with the same case (its
+        /// case.resolved.toml) is taken back as it is, a run an interrupt stopped there continues
+        /// from its checkpoint; every other speed runs afresh (without --resume every speed runs
+        /// afresh).
+        #[arg(long)]
+        resume: bool,
     },
     /// Benchmark fixed workloads: shape functions, material kernel, force
     /// assembly, whole steps (1 and all threads), optionally whole cases.
@@ -284,9 +290,11 @@ fn dispatch(cmd: Command) -> Result<()> {
             out,
             experiments,
             rows,
+            resume,
         } => {
             let (case, name, file) = load(&case_file, &case, &set)?;
-            let args = BallisticArgs { speeds, limit, lo, hi, tol, max_time, projectile, jobs, experiments, rows };
+            let args =
+                BallisticArgs { speeds, limit, lo, hi, tol, max_time, projectile, jobs, experiments, rows, resume };
             ballistic(case, &name, &file, &set, out, args)
         }
         Command::Bench { case, steps, whole, set } => bench(&case, steps, whole, &set),
@@ -566,6 +574,7 @@ struct BallisticArgs {
     jobs: Option<usize>,
     experiments: Option<PathBuf>,
     rows: Vec<usize>,
+    resume: bool,
 }
 
 fn ballistic(
@@ -683,6 +692,7 @@ fn one_study(
         out_dir: out_dir.to_path_buf(),
         max_time,
         interrupt: interrupt.clone(),
+        resume: args.resume,
     };
     let body = projectile.name(&setup.case);
     let kind = match projectile {
@@ -719,7 +729,22 @@ fn one_study(
                 shot.wall
             ),
             Event::Failed { speed, message } => eprintln!("[{at:6.0} s]   {speed:.2} m/s failed: {message}"),
-            Event::Interrupted { speed } => eprintln!("[{at:6.0} s]   {speed:.2} m/s interrupted"),
+            Event::Interrupted { speed } => {
+                eprintln!("[{at:6.0} s]   {speed:.2} m/s interrupted (its checkpoint is kept: --resume continues it)")
+            }
+            Event::Reused { shot, note } => eprintln!(
+                "[{at:6.0} s]   {:.2} m/s: {}{}, finished before: taken back{}",
+                shot.speed,
+                shot.outcome(),
+                shot.residual().map(|v| format!(", v_r = {v:.2} m/s")).unwrap_or_default(),
+                note.map(|n| format!(" ({n})")).unwrap_or_default()
+            ),
+            Event::Resumed { speed, time, warnings } => {
+                eprintln!("[{at:6.0} s]   {speed:.2} m/s continues from its checkpoint at {:.1} us", time * 1e6);
+                for w in warnings {
+                    eprintln!("[{at:6.0} s]   {speed:.2} m/s: warning: {w}");
+                }
+            }
         }
     };
     eprintln!(

@@ -103,7 +103,7 @@ impl ReleaseTracker {
 }
 
 /// How a projectile's flight ended.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Verdict {
     /// Released with a plug cut out: the residual velocity `residual` (m/s,
     /// along the flight), the axial force having vanished since `since` (s).

@@ -35,6 +35,7 @@ fn setup(name: &str, jobs: usize) -> Setup {
         out_dir,
         max_time: 100.0e-6,
         interrupt: None,
+        resume: false,
     }
 }
 
@@ -306,6 +307,7 @@ fn a_study_fires_a_deformable_projectile() {
         out_dir: out_dir.clone(),
         max_time: 0.0,
         interrupt: None,
+        resume: false,
     };
     let mut study = Study::default();
     run_speeds(&s, &[500.0], &mut study, &mut |_| Ok(()), &mut |_| {}).unwrap();
@@ -320,4 +322,89 @@ fn a_study_fires_a_deformable_projectile() {
     let info = std::fs::read_to_string(shot.dir.join("run_info.toml")).unwrap();
     assert!(info.contains("bodies.projectile.initial_velocity"), "{info}");
     std::fs::remove_dir_all(&out_dir).ok();
+}
+
+/// `--resume`: a run an interrupt stopped continues from its checkpoint to
+/// the result of a run never stopped, to the bit; run again, the finished
+/// run is taken back without running; a changed case or a study without
+/// `--resume` runs afresh.
+#[test]
+fn a_resumed_study_continues_the_interrupted_runs_and_takes_back_the_finished() {
+    let speed = 300.0;
+    let same = |a: &plugsim::ballistic::Shot, b: &plugsim::ballistic::Shot| {
+        assert_eq!(
+            (a.verdict, a.perforation, a.plug_mass, a.end_time, a.fastest, a.steps),
+            (b.verdict, b.perforation, b.plug_mass, b.end_time, b.fastest, b.steps)
+        );
+    };
+    // Progress reports every 4 us (10 % of the end time).
+    let short = |name: &str| {
+        let mut s = setup(name, 1);
+        s.case.time.end = 40.0e-6;
+        s.max_time = 40.0e-6;
+        s
+    };
+    // The reference: never stopped.
+    let whole = short("resume-whole");
+    let mut reference = Study::default();
+    run_speeds(&whole, &[speed], &mut reference, &mut |_| Ok(()), &mut |_| {}).unwrap();
+    let reference = reference.shots[0].clone();
+    assert!(matches!(reference.verdict, Verdict::Perforated { .. }), "{:?}", reference.verdict);
+    assert!(reference.end_time > 8.0e-6, "long enough to stop it on the way: {}", reference.end_time);
+
+    // Stopped at its first progress report.
+    let mut s = short("resume");
+    let flag = Arc::new(AtomicBool::new(false));
+    s.interrupt = Some(flag.clone());
+    let mut study = Study::default();
+    run_speeds(&s, &[speed], &mut study, &mut |_| Ok(()), &mut |e| {
+        if matches!(e, Event::Advanced { .. }) {
+            flag.store(true, Ordering::SeqCst);
+        }
+    })
+    .unwrap();
+    assert!(study.interrupted && study.shots.is_empty());
+    let dir = plugsim::ballistic::run_dir(&s.out_dir, speed);
+    assert!(!dir.join(plugsim::ballistic::SHOT_FILE).exists());
+
+    // Resumed: continues from the checkpoint, to the reference's result.
+    s.interrupt = None;
+    s.resume = true;
+    let mut events = Vec::new();
+    let mut study = Study::default();
+    run_speeds(&s, &[speed], &mut study, &mut |_| Ok(()), &mut |e| events.push(e)).unwrap();
+    let resumed_at = events.iter().find_map(|e| match e {
+        Event::Resumed { time, .. } => Some(*time),
+        _ => None,
+    });
+    assert!(resumed_at.is_some_and(|t| t >= 4.0e-6 && t < reference.end_time), "{resumed_at:?}");
+    same(&study.shots[0], &reference);
+    assert!(dir.join(plugsim::ballistic::SHOT_FILE).exists());
+    let history = std::fs::read(dir.join("history.csv")).unwrap();
+    assert_eq!(
+        history,
+        std::fs::read(reference.dir.join("history.csv")).unwrap(),
+        "the same history as a run never stopped"
+    );
+
+    // Again: taken back, nothing runs.
+    let mut events = Vec::new();
+    let mut again = Study::default();
+    run_speeds(&s, &[speed], &mut again, &mut |_| Ok(()), &mut |e| events.push(e)).unwrap();
+    assert!(matches!(events.as_slice(), [Event::Reused { note: None, .. }]), "{events:?}");
+    assert_eq!(again.shots, study.shots, "the whole row, wall time included");
+
+    // Another case (a later max time) or no --resume: runs afresh.
+    for (max_time, resume) in [(50.0e-6, true), (40.0e-6, false)] {
+        s.max_time = max_time;
+        s.resume = resume;
+        let mut events = Vec::new();
+        let mut fresh = Study::default();
+        run_speeds(&s, &[speed], &mut fresh, &mut |_| Ok(()), &mut |e| events.push(e)).unwrap();
+        assert!(matches!(events.first(), Some(Event::Started { .. })), "{events:?}");
+        assert!(!events.iter().any(|e| matches!(e, Event::Reused { .. } | Event::Resumed { .. })), "{events:?}");
+        same(&fresh.shots[0], &reference);
+    }
+    std::fs::remove_dir_all(&s.out_dir).ok();
+    std::fs::remove_dir_all(&whole.out_dir).ok();
 }
