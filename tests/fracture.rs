@@ -965,3 +965,67 @@ fn crack_tip_advances_at_the_prescribed_speed() {
     let advances = g.events.iter().filter(|e| e.kind == EventKind::Propagate).count();
     assert!(advances >= 30 && track.len() <= advances + 1, "{advances} advances in {} stages", track.len());
 }
+
+/// Coalescence (`CrackGrowth::junction`): a crack from the top whose tip
+/// is one spacing above a second crack's face (from the bottom surface,
+/// turned sideways under it) has no candidate — every particle ahead is a
+/// face of the other crack or behind it — and is not on an outer surface.
+/// Without the join it would wait forever and hold the plug by that
+/// bridge (found at 96 rows, docs/validation.md); it ends on the other
+/// crack instead, with the split's invariants, and the two cracks cut out
+/// the piece between them and the free edge.
+#[test]
+fn a_tip_that_reaches_another_crack_joins_it() {
+    let (nx, ny) = (25, 9);
+    let mut m = plate(nx, ny);
+    non_uniform_velocity(&mut m);
+    // failed left of x = 9H, intact to the right (the second crack's tip stays put)
+    set_field(&mut m, |x| if x.x < 9.0 * H { 0.6 } else { 0.0 });
+    let mut g = CrackGrowth::new(FractureParameters {
+        nucleation_distance_factor: 100.0,
+        ..params(Criterion::EffectiveStrain)
+    });
+    let bottom: Vec<usize> = [(2, 0), (3, 1), (4, 2), (5, 2), (6, 2), (7, 2), (8, 2), (9, 2), (10, 2)]
+        .iter()
+        .map(|&(i, j)| id(&m, i, j))
+        .collect();
+    g.insert_crack(&mut m, &bottom, false).unwrap();
+    let top: Vec<usize> = (3..ny).rev().map(|j| id(&m, 8, j)).collect();
+    g.insert_crack(&mut m, &top, false).unwrap();
+    assert_eq!(g.cracks[1].tip, Some(id(&m, 8, 3)));
+    assert!(plugsim::plug::plug_particles(&m, &g, 0.0).is_none(), "the bridge under the tip holds");
+    let events = g.events.len();
+    drive(&mut m, &mut g, 3);
+    let joins: Vec<_> = g.events[events..].iter().filter(|e| e.kind == EventKind::Join).collect();
+    assert_eq!(joins.len(), 1, "{:?}", &g.events[events..]);
+    assert_eq!(joins[0].crack, 1);
+    let c = &g.cracks[1];
+    assert!(c.tip.is_none() && c.arrested.is_some());
+    let end = c.vertices.last().unwrap().x0;
+    assert!((end - Vec2::new(8.0 * H, 2.0 * H)).norm() < 1e-12, "ends on the other crack's path below: {end:?}");
+    assert!(g.cracks[0].tip.is_some(), "the other crack grows on, unchanged");
+    // the piece left of the top crack and above the bottom one is cut out
+    let plug = plugsim::plug::plug_particles(&m, &g, 0.0).expect("cut out by the two cracks");
+    assert!(plug.iter().all(|&i| m.particles.x0[i].x < 8.0 * H), "left of the joined crack");
+    assert!(plug.len() > 40, "{} particles", plug.len());
+    // A tip with intact material ahead does not join a crack beyond it:
+    // the same two cracks, the top one stopped two spacings higher, with
+    // nothing failed below it (the criterion decides that ligament).
+    let mut open = plate(nx, ny);
+    set_field(&mut open, |x| if x.x < 9.0 * H && x.y > 3.5 * H { 0.6 } else { 0.0 });
+    let mut h = CrackGrowth::new(FractureParameters {
+        nucleation_distance_factor: 100.0,
+        ..params(Criterion::EffectiveStrain)
+    });
+    let bottom: Vec<usize> = [(2, 0), (3, 1), (4, 2), (5, 2), (6, 2), (7, 2), (8, 2), (9, 2), (10, 2)]
+        .iter()
+        .map(|&(i, j)| id(&open, i, j))
+        .collect();
+    h.insert_crack(&mut open, &bottom, false).unwrap();
+    let top: Vec<usize> = (4..ny).rev().map(|j| id(&open, 8, j)).collect();
+    h.insert_crack(&mut open, &top, false).unwrap();
+    let events = h.events.len();
+    drive(&mut open, &mut h, 3);
+    assert!(h.events[events..].iter().all(|e| e.kind != EventKind::Join), "{:?}", &h.events[events..]);
+    assert_eq!(h.cracks[1].tip, Some(id(&open, 8, 4)), "waits for the criterion");
+}

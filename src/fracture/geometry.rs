@@ -138,15 +138,20 @@ pub fn sector_contains(sector: (Real, Real), d: &Vec2) -> bool {
     a <= sector.0
 }
 
-/// Distance from point `x` to segment `[a, b]`.
-pub fn point_segment_distance(a: &Vec2, b: &Vec2, x: &Vec2) -> Real {
+/// The point of segment `[a, b]` nearest to `x`.
+pub fn closest_point_on_segment(a: &Vec2, b: &Vec2, x: &Vec2) -> Vec2 {
     let d = b - a;
     let l2 = d.norm_squared();
     if l2 == 0.0 {
-        return (x - a).norm();
+        return *a;
     }
     let t = ((x - a).dot(&d) / l2).clamp(0.0, 1.0);
-    (a + d * t - x).norm()
+    a + d * t
+}
+
+/// Distance from point `x` to segment `[a, b]`.
+pub fn point_segment_distance(a: &Vec2, b: &Vec2, x: &Vec2) -> Real {
+    (closest_point_on_segment(a, b, x) - x).norm()
 }
 
 #[cfg(test)]

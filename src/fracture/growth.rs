@@ -4,7 +4,8 @@
 //! [`crate::fracture`] for the choices and deviations.
 
 use super::geometry::{
-    left_bisector, left_normal, point_segment_distance, sector_angles, sector_contains, widest_empty_sector,
+    closest_point_on_segment, left_bisector, left_normal, point_segment_distance, sector_angles, sector_contains,
+    widest_empty_sector,
 };
 use super::nonlocal::NonlocalAverage;
 use super::visibility::{CrackSegments, CrackVisibility};
@@ -77,7 +78,7 @@ fn logged_event(
             lumped_projection(model, decider, |q| model.adiabatic_hardening(q)),
         )
     };
-    let particles = if kind == EventKind::Arrest { Vec::new() } else { vec![decider] };
+    let particles = if kind.grows() { vec![decider] } else { Vec::new() };
     CrackEvent { time: at.0, step: at.1, crack, kind, particles, value, damage, hardening }
 }
 
@@ -113,6 +114,9 @@ pub enum EventKind {
     Nucleate,
     Propagate,
     Arrest,
+    /// The tip reached another crack and ended on it (coalescence,
+    /// `CrackGrowth::junction`).
+    Join,
 }
 
 impl EventKind {
@@ -121,7 +125,14 @@ impl EventKind {
             EventKind::Nucleate => "nucleate",
             EventKind::Propagate => "propagate",
             EventKind::Arrest => "arrest",
+            EventKind::Join => "join",
         }
+    }
+
+    /// Whether the crack grew into a new particle (its decider is a new
+    /// tip): not at an arrest or a join, which end the crack at its tip.
+    pub fn grows(self) -> bool {
+        matches!(self, EventKind::Nucleate | EventKind::Propagate)
     }
 }
 
@@ -483,8 +494,7 @@ impl CrackGrowth {
     }
 
     fn tip_values(&self, value: impl Fn(&CrackEvent) -> Real) -> Option<TipValues> {
-        let v: Vec<Real> =
-            self.events.iter().filter(|e| e.kind != EventKind::Arrest).map(value).filter(|v| v.is_finite()).collect();
+        let v: Vec<Real> = self.events.iter().filter(|e| e.kind.grows()).map(value).filter(|v| v.is_finite()).collect();
         TipValues::of(v)
     }
 
@@ -555,6 +565,12 @@ impl CrackGrowth {
                     }
                 }
                 best = Some((rank, value, j));
+            }
+            if best.is_none() {
+                if let Some(junction) = self.junction(model, c, critical) {
+                    faces.extend(self.join(model, c, junction, time, step)?);
+                    continue;
+                }
             }
             if !self.tip_may_advance(model, c, best.map(|(_, _, j)| j), dt) {
                 continue;
@@ -899,6 +915,98 @@ impl CrackGrowth {
         self.cracks[c].tip = None;
         self.cracks[c].arrested = Some((time, step));
         let split = Split { parent: tip, vertex: xt, incoming: d, outgoing: d, reach: last_len, offset };
+        self.split_logged(model, n - 1, split, event)
+    }
+
+    /// Coalescence (a deviation from \[RL10\], issue #19): where the tip of
+    /// crack `c`, with no candidate ahead, ends on another crack — the
+    /// nearest point of another crack's path (its vertices, not the
+    /// extensions) within the tip's circle `R` and inside both fans — if
+    /// the way ahead is cut (every particle of the circle inside both fans
+    /// is a crack face or hidden from the tip by a crack: no intact
+    /// material to cross, which only the criterion may do) and the tip
+    /// itself meets the criterion `critical` and is not compressed
+    /// (triaxiality ≥ −1/3, as every candidate). \[RL10\]'s rules know the
+    /// outer surface only: a tip that reaches another crack's face finds
+    /// every particle ahead a face of that crack or behind it, so it
+    /// neither advances nor arrests, and the ligament it leaves holds the
+    /// plug, which is found between through-cracks only. Found on Case I's
+    /// plate at 96 rows and 116.67 m/s: the ring crack from the corner
+    /// stopped one spacing above a second crack from the bottom face while
+    /// the plug moved away at 41 m/s (docs/validation.md, "The issue's
+    /// ladder"). The same rule carries to 3D as a crack front meeting
+    /// another crack surface. Test: `a_tip_that_reaches_another_crack_joins_it`.
+    fn junction(&self, model: &Model, c: usize, critical: Real) -> Option<Vec2> {
+        let tip = self.cracks[c].tip?;
+        let p = &model.particles;
+        let xt = p.x0[tip];
+        if self.criterion_value(model, tip) < critical || self.triaxiality(model, tip) < NUCLEATION_MIN_TRIAXIALITY {
+            return None;
+        }
+        let d = self.cracks[c].direction();
+        let mean = (xt - self.cracks[c].vertices[0].x0).normalize();
+        let half_fan = 0.5 * self.params.fan_angle.to_radians();
+        let in_fans = |r: &Vec2| r.norm() > 0.0 && angle(r, &d) <= half_fan && angle(r, &mean) <= half_fan;
+        // Only where the way ahead is cut: a particle ahead that is no crack
+        // face and is seen from the tip is intact material, which the tip
+        // must cross by the criterion.
+        let open = self.circle(model, tip).into_iter().any(|j| {
+            in_fans(&(p.x0[j] - xt))
+                && !p.flags[j].has(ParticleFlags::CRACK_FACE)
+                && !self.blocked_from_tip(model, c, j)
+        });
+        if open {
+            return None;
+        }
+        let reach = self.params.radius_factor * p.spacing[tip];
+        let mut best: Option<(Real, Vec2)> = None;
+        for (k, other) in self.cracks.iter().enumerate() {
+            // the same body's cracks only (bodies overlap in the reference configuration)
+            let body = other.vertices.iter().find_map(|v| v.faces).map(|(l, _)| p.body[l as usize]);
+            if k == c || body != Some(p.body[tip]) {
+                continue;
+            }
+            for w in other.vertices.windows(2) {
+                let x = closest_point_on_segment(&w[0].x0, &w[1].x0, &xt);
+                let r = x - xt;
+                let dist = r.norm();
+                if dist > reach || !in_fans(&r) {
+                    continue;
+                }
+                if best.is_none_or(|(b, _)| dist < b) {
+                    best = Some((dist, x));
+                }
+            }
+        }
+        best.map(|(_, x)| x)
+    }
+
+    /// Join: end crack `c` at `junction` on another crack — split the tip
+    /// toward it (the last segment runs from the tip to the junction and is
+    /// extended beyond it, across the other crack, like an arrest's past
+    /// the surface) and stop.
+    fn join(
+        &mut self,
+        model: &mut Model,
+        c: usize,
+        junction: Vec2,
+        time: Real,
+        step: u64,
+    ) -> Result<Vec<usize>, FractureError> {
+        let tip = self.cracks[c].tip.expect("growing");
+        let value = self.criterion_value(model, tip);
+        let event = logged_event(model, (time, step), c, EventKind::Join, tip, value);
+        let xt = model.particles.x0[tip];
+        let incoming = self.cracks[c].direction();
+        let outgoing = (junction - xt).normalize();
+        let n = self.cracks[c].vertices.len();
+        let last_len = (xt - self.cracks[c].vertices[n - 2].x0).norm();
+        let offset = self.cracks[c].offset;
+        self.cracks[c].vertices.push(CrackVertex { x0: junction, faces: None });
+        self.cracks[c].tip = None;
+        self.cracks[c].arrested = Some((time, step));
+        let split =
+            Split { parent: tip, vertex: xt, incoming, outgoing, reach: last_len.min((junction - xt).norm()), offset };
         self.split_logged(model, n - 1, split, event)
     }
 

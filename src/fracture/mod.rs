@@ -91,6 +91,16 @@
 //!   surface). We read \[RL10\]'s `θ_max − θ_min > θ_c` as the width of that
 //!   empty sector between consecutive particle directions
 //!   (`arrest_at_the_far_surface_without_running_along_it`).
+//! - **Coalescence** (a deviation; `CrackGrowth::junction`): a
+//!   tip with no candidate that has another crack's path within `R` inside
+//!   its fans ends on it — a last segment to the nearest point of that
+//!   path, split as an arrest (event `join`) — if the tip meets the
+//!   criterion and is not compressed. \[RL10\]'s arrest knows the outer
+//!   surface only; a tip one spacing from another crack's face (every
+//!   particle ahead a face of it or behind it) neither advanced nor
+//!   arrested, and the bridge it left held a plug that moved away at
+//!   41 m/s (Case I's plate, 96 rows, 116.67 m/s; docs/validation.md).
+//!   (`a_tip_that_reaches_another_crack_joins_it`)
 //! - The fan is applied twice: candidates lie within `θ_c/2` of the last
 //!   segment's direction (\[RL10\]) **and** of the crack's mean direction
 //!   (nucleation point to tip). With the last segment alone a crack can
