@@ -977,22 +977,28 @@ fn crack_tip_advances_at_the_prescribed_speed() {
 #[test]
 fn a_tip_that_reaches_another_crack_joins_it() {
     let (nx, ny) = (25, 9);
-    let mut m = plate(nx, ny);
-    non_uniform_velocity(&mut m);
+    // A crack from the bottom surface turned sideways along row 2 (its tip
+    // at (10, 2)), and one down column 8 from the top to row `lowest`.
+    let two_cracks = |field: &dyn Fn(&Vec2) -> Real, lowest: usize| {
+        let mut m = plate(nx, ny);
+        non_uniform_velocity(&mut m);
+        set_field(&mut m, field);
+        let mut g = CrackGrowth::new(FractureParameters {
+            nucleation_distance_factor: 100.0,
+            ..params(Criterion::EffectiveStrain)
+        });
+        let bottom: Vec<usize> = [(2, 0), (3, 1), (4, 2), (5, 2), (6, 2), (7, 2), (8, 2), (9, 2), (10, 2)]
+            .iter()
+            .map(|&(i, j)| id(&m, i, j))
+            .collect();
+        g.insert_crack(&mut m, &bottom, false).unwrap();
+        let top: Vec<usize> = (lowest..ny).rev().map(|j| id(&m, 8, j)).collect();
+        g.insert_crack(&mut m, &top, false).unwrap();
+        assert_eq!(g.cracks[1].tip, Some(id(&m, 8, lowest)));
+        (m, g)
+    };
     // failed left of x = 9H, intact to the right (the second crack's tip stays put)
-    set_field(&mut m, |x| if x.x < 9.0 * H { 0.6 } else { 0.0 });
-    let mut g = CrackGrowth::new(FractureParameters {
-        nucleation_distance_factor: 100.0,
-        ..params(Criterion::EffectiveStrain)
-    });
-    let bottom: Vec<usize> = [(2, 0), (3, 1), (4, 2), (5, 2), (6, 2), (7, 2), (8, 2), (9, 2), (10, 2)]
-        .iter()
-        .map(|&(i, j)| id(&m, i, j))
-        .collect();
-    g.insert_crack(&mut m, &bottom, false).unwrap();
-    let top: Vec<usize> = (3..ny).rev().map(|j| id(&m, 8, j)).collect();
-    g.insert_crack(&mut m, &top, false).unwrap();
-    assert_eq!(g.cracks[1].tip, Some(id(&m, 8, 3)));
+    let (mut m, mut g) = two_cracks(&|x| if x.x < 9.0 * H { 0.6 } else { 0.0 }, 3);
     assert!(plugsim::plug::plug_particles(&m, &g, 0.0).is_none(), "the bridge under the tip holds");
     let events = g.events.len();
     drive(&mut m, &mut g, 3);
@@ -1009,23 +1015,11 @@ fn a_tip_that_reaches_another_crack_joins_it() {
     assert!(plug.iter().all(|&i| m.particles.x0[i].x < 8.0 * H), "left of the joined crack");
     assert!(plug.len() > 40, "{} particles", plug.len());
     // A tip with intact material ahead does not join a crack beyond it:
-    // the same two cracks, the top one stopped two spacings higher, with
-    // nothing failed below it (the criterion decides that ligament).
-    let mut open = plate(nx, ny);
-    set_field(&mut open, |x| if x.x < 9.0 * H && x.y > 3.5 * H { 0.6 } else { 0.0 });
-    let mut h = CrackGrowth::new(FractureParameters {
-        nucleation_distance_factor: 100.0,
-        ..params(Criterion::EffectiveStrain)
-    });
-    let bottom: Vec<usize> = [(2, 0), (3, 1), (4, 2), (5, 2), (6, 2), (7, 2), (8, 2), (9, 2), (10, 2)]
-        .iter()
-        .map(|&(i, j)| id(&open, i, j))
-        .collect();
-    h.insert_crack(&mut open, &bottom, false).unwrap();
-    let top: Vec<usize> = (4..ny).rev().map(|j| id(&open, 8, j)).collect();
-    h.insert_crack(&mut open, &top, false).unwrap();
-    let events = h.events.len();
-    drive(&mut open, &mut h, 3);
-    assert!(h.events[events..].iter().all(|e| e.kind != EventKind::Join), "{:?}", &h.events[events..]);
-    assert_eq!(h.cracks[1].tip, Some(id(&open, 8, 4)), "waits for the criterion");
+    // the top crack stopped one spacing higher, nothing failed below it
+    // (the criterion decides that ligament).
+    let (mut m, mut g) = two_cracks(&|x| if x.x < 9.0 * H && x.y > 3.5 * H { 0.6 } else { 0.0 }, 4);
+    let events = g.events.len();
+    drive(&mut m, &mut g, 3);
+    assert!(g.events[events..].iter().all(|e| e.kind != EventKind::Join), "{:?}", &g.events[events..]);
+    assert_eq!(g.cracks[1].tip, Some(id(&m, 8, 4)), "waits for the criterion");
 }

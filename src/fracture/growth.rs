@@ -904,17 +904,35 @@ impl CrackGrowth {
     /// Arrest: split the tip in halves, extend the path by δ, stop.
     fn arrest(&mut self, model: &mut Model, c: usize, time: Real, step: u64) -> Result<Vec<usize>, FractureError> {
         let tip = self.cracks[c].tip.expect("growing");
-        let value = self.criterion_value(model, tip);
-        let event = logged_event(model, (time, step), c, EventKind::Arrest, tip, value);
         let xt = model.particles.x0[tip];
         let d = self.cracks[c].direction();
         let n = self.cracks[c].vertices.len();
         let last_len = (xt - self.cracks[c].vertices[n - 2].x0).norm();
+        self.end_crack(model, c, EventKind::Arrest, (time, step), (xt + d * self.cracks[c].offset, d, last_len))
+    }
+
+    /// End crack `c` at its tip (an arrest or a join): the path's last
+    /// vertex at `end.0`, the tip split between the incoming direction and
+    /// `end.1` with reach `end.2`, the crack stopped, the event logged.
+    fn end_crack(
+        &mut self,
+        model: &mut Model,
+        c: usize,
+        kind: EventKind,
+        (time, step): (Real, u64),
+        (end, outgoing, reach): (Vec2, Vec2, Real),
+    ) -> Result<Vec<usize>, FractureError> {
+        let tip = self.cracks[c].tip.expect("growing");
+        let value = self.criterion_value(model, tip);
+        let event = logged_event(model, (time, step), c, kind, tip, value);
+        let xt = model.particles.x0[tip];
+        let incoming = self.cracks[c].direction();
+        let n = self.cracks[c].vertices.len();
         let offset = self.cracks[c].offset;
-        self.cracks[c].vertices.push(CrackVertex { x0: xt + d * offset, faces: None });
+        self.cracks[c].vertices.push(CrackVertex { x0: end, faces: None });
         self.cracks[c].tip = None;
         self.cracks[c].arrested = Some((time, step));
-        let split = Split { parent: tip, vertex: xt, incoming: d, outgoing: d, reach: last_len, offset };
+        let split = Split { parent: tip, vertex: xt, incoming, outgoing, reach, offset };
         self.split_logged(model, n - 1, split, event)
     }
 
@@ -994,20 +1012,12 @@ impl CrackGrowth {
         step: u64,
     ) -> Result<Vec<usize>, FractureError> {
         let tip = self.cracks[c].tip.expect("growing");
-        let value = self.criterion_value(model, tip);
-        let event = logged_event(model, (time, step), c, EventKind::Join, tip, value);
         let xt = model.particles.x0[tip];
-        let incoming = self.cracks[c].direction();
-        let outgoing = (junction - xt).normalize();
         let n = self.cracks[c].vertices.len();
         let last_len = (xt - self.cracks[c].vertices[n - 2].x0).norm();
-        let offset = self.cracks[c].offset;
-        self.cracks[c].vertices.push(CrackVertex { x0: junction, faces: None });
-        self.cracks[c].tip = None;
-        self.cracks[c].arrested = Some((time, step));
-        let split =
-            Split { parent: tip, vertex: xt, incoming, outgoing, reach: last_len.min((junction - xt).norm()), offset };
-        self.split_logged(model, n - 1, split, event)
+        let to_junction = junction - xt;
+        let end = (junction, to_junction.normalize(), last_len.min(to_junction.norm()));
+        self.end_crack(model, c, EventKind::Join, (time, step), end)
     }
 
     /// Split a particle at a crack vertex and rebuild what the change
