@@ -630,12 +630,11 @@ struct FinishedRun {
     shot: Shot,
 }
 
-/// Whether the run directory `dir` was started with the case this study
-/// runs at `speed`: its `case.resolved.toml` is the one
-/// [`at_speed`] gives, to the byte (every material constant, setting and
-/// the time it may run to).
-fn started_with_this_case(setup: &Setup, speed: Real, dir: &Path) -> bool {
-    let (case, _) = at_speed(&setup.case, setup.projectile, speed, setup.max_time);
+/// Whether the run directory `dir` was started with `case` (the one
+/// [`at_speed`] gives for its speed): its `case.resolved.toml` is that
+/// case's, to the byte (every material constant, setting and the time it
+/// may run to).
+fn started_with(case: &Case, dir: &Path) -> bool {
     std::fs::read_to_string(dir.join("case.resolved.toml")).is_ok_and(|text| text == case.resolved_toml())
 }
 
@@ -645,7 +644,7 @@ fn started_with_this_case(setup: &Setup, speed: Real, dir: &Path) -> bool {
 /// it (its result is that build's).
 pub fn finished_run(setup: &Setup, speed: Real) -> Option<(Shot, Option<String>)> {
     let dir = run_dir(&setup.out_dir, speed);
-    if !started_with_this_case(setup, speed, &dir) {
+    if !started_with(&at_speed(&setup.case, setup.projectile, speed, setup.max_time).0, &dir) {
         return None;
     }
     let run: FinishedRun = toml::from_str(&std::fs::read_to_string(dir.join(SHOT_FILE)).ok()?).ok()?;
@@ -685,8 +684,8 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
         }
         _ => {}
     };
-    let interrupted = !crate::checkpoint::list(&crate::checkpoint::directory(&dir)).is_empty();
-    let result = if setup.resume && interrupted && started_with_this_case(setup, speed, &dir) {
+    let interrupted = || !crate::checkpoint::list(&crate::checkpoint::directory(&dir)).is_empty();
+    let result = if setup.resume && interrupted() && started_with(&case, &dir) {
         crate::run::resume(&cfg, &mut report)
     } else {
         // a fresh run: no earlier result may stand for it

@@ -108,6 +108,13 @@ fn angle(a: &Vec2, b: &Vec2) -> Real {
     (a.dot(b) / (a.norm() * b.norm())).clamp(-1.0, 1.0).acos()
 }
 
+/// Whether `r` (from a tip) lies inside both fans of half-angle `half_fan`
+/// (rad): around the last segment's direction `d` and the crack's mean
+/// direction `mean` (crate::fracture, "The fan is applied twice").
+fn in_fans(r: &Vec2, d: &Vec2, mean: &Vec2, half_fan: Real) -> bool {
+    r.norm() > 0.0 && angle(r, d) <= half_fan && angle(r, mean) <= half_fan
+}
+
 /// What happened to a crack.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum EventKind {
@@ -545,7 +552,7 @@ impl CrackGrowth {
                     continue;
                 }
                 let r = model.particles.x0[j] - xt;
-                if r.norm() == 0.0 || angle(&r, &d) > half_fan || angle(&r, &mean) > half_fan {
+                if !in_fans(&r, &d, &mean, half_fan) {
                     continue;
                 }
                 let value = self.criterion_value(model, j);
@@ -567,7 +574,7 @@ impl CrackGrowth {
                 best = Some((rank, value, j));
             }
             if best.is_none() {
-                if let Some(junction) = self.junction(model, c, critical) {
+                if let Some(junction) = self.junction(model, c, critical, &circle, (d, mean)) {
                     faces.extend(self.join(model, c, junction, time, step)?);
                     continue;
                 }
@@ -953,22 +960,29 @@ impl CrackGrowth {
     /// stopped one spacing above a second crack from the bottom face while
     /// the plug moved away at 41 m/s (docs/validation.md, "The issue's
     /// ladder"). The same rule carries to 3D as a crack front meeting
-    /// another crack surface. Test: `a_tip_that_reaches_another_crack_joins_it`.
-    fn junction(&self, model: &Model, c: usize, critical: Real) -> Option<Vec2> {
+    /// another crack surface. `circle` is the tip's circle, `(d, mean)` its
+    /// fans' directions, as `grow` found them. Test:
+    /// `a_tip_that_reaches_another_crack_joins_it`.
+    fn junction(
+        &self,
+        model: &Model,
+        c: usize,
+        critical: Real,
+        circle: &[usize],
+        (d, mean): (Vec2, Vec2),
+    ) -> Option<Vec2> {
         let tip = self.cracks[c].tip?;
         let p = &model.particles;
         let xt = p.x0[tip];
         if self.criterion_value(model, tip) < critical || self.triaxiality(model, tip) < NUCLEATION_MIN_TRIAXIALITY {
             return None;
         }
-        let d = self.cracks[c].direction();
-        let mean = (xt - self.cracks[c].vertices[0].x0).normalize();
         let half_fan = 0.5 * self.params.fan_angle.to_radians();
-        let in_fans = |r: &Vec2| r.norm() > 0.0 && angle(r, &d) <= half_fan && angle(r, &mean) <= half_fan;
+        let in_fans = |r: &Vec2| in_fans(r, &d, &mean, half_fan);
         // Only where the way ahead is cut: a particle ahead that is no crack
         // face and is seen from the tip is intact material, which the tip
         // must cross by the criterion.
-        let open = self.circle(model, tip).into_iter().any(|j| {
+        let open = circle.iter().any(|&j| {
             in_fans(&(p.x0[j] - xt))
                 && !p.flags[j].has(ParticleFlags::CRACK_FACE)
                 && !self.blocked_from_tip(model, c, j)

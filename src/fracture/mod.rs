@@ -92,10 +92,11 @@
 //!   empty sector between consecutive particle directions
 //!   (`arrest_at_the_far_surface_without_running_along_it`).
 //! - **Coalescence** (a deviation; `CrackGrowth::junction`): a
-//!   tip with no candidate that has another crack's path within `R` inside
-//!   its fans ends on it — a last segment to the nearest point of that
-//!   path, split as an arrest (event `join`) — if the tip meets the
-//!   criterion and is not compressed. \[RL10\]'s arrest knows the outer
+//!   tip with no candidate whose way ahead is cut by another crack (every
+//!   particle of its circle inside its fans a crack face or hidden from it
+//!   by a crack) ends on that crack's path — a last segment to its nearest
+//!   point within `R` inside the fans, split as an arrest (event `join`) —
+//!   if the tip meets the criterion and is not compressed. \[RL10\]'s arrest knows the outer
 //!   surface only; a tip one spacing from another crack's face (every
 //!   particle ahead a face of it or behind it) neither advanced nor
 //!   arrested, and the bridge it left held a plug that moved away at
