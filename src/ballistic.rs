@@ -1039,12 +1039,23 @@ pub fn spread(values: &[Real]) -> Option<Real> {
     Some((hi - lo) / (values.iter().sum::<Real>() / values.len() as Real))
 }
 
+/// The change from `coarse` to `fine` relative to `coarse`, each given as
+/// (value, half-width of its bracket): (central, least, most), the least and
+/// most being the change when each value may lie anywhere in its bracket
+/// (a residual velocity has half-width 0, a ballistic limit its bisection's).
+pub fn step(coarse: (Real, Real), fine: (Real, Real)) -> (Real, Real, Real) {
+    let ((c, hc), (f, hf)) = (coarse, fine);
+    ((f - c) / c, (f - hf - (c + hc)) / (c + hc), (f + hf - (c - hc)) / (c - hc))
+}
+
 /// The resolutions side by side, as (Markdown, CSV): per rung the ballistic
 /// limit, the Recht–Ipson fit and the residual velocity at each of
-/// `speeds`, then the spread of each across the rungs ([`spread`]); the
-/// limit's spread counts only bracketed limits, a residual's only if every
-/// rung perforated at that speed (a held run is 0 m/s, which no spread
-/// describes: the Markdown says "held").
+/// `speeds`, then the spread of each across the rungs ([`spread`]) and the
+/// last refinement's [`step`] (from the second-finest rung to the finest:
+/// what one more refinement moved, the usual test of a converged result);
+/// the limit's spread and step count only bracketed limits, a residual's
+/// only if every rung perforated at that speed (a held run is 0 m/s, which
+/// no spread describes: the Markdown says "held").
 pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
     let mut md = String::from("| rows | spacing (mm) | v_bl (m/s) | Recht–Ipson a, p, v_bl |");
     let mut csv = String::from("rows,spacing_mm,v_bl_m_s,v_bl_half_width_m_s,a,p,fit_v_bl_m_s");
@@ -1102,6 +1113,30 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
         md.push_str(&format!(" {} |", pct(vr.and_then(|x| spread(&x)))));
     }
     md.push_str(" | |\n");
+    // The two finest rungs, by rows (the order given need not be).
+    let mut by_rows: Vec<&Rung> = rungs.iter().collect();
+    by_rows.sort_by_key(|r| r.rows);
+    if let [.., coarse, fine] = by_rows[..] {
+        let signed = |x: Real| format!("{:+.1} %", 100.0 * x);
+        let limit = |r: &Rung| r.study.limit.as_ref().and_then(|l| l.estimate());
+        md.push_str(&format!("| step {} → {} rows | | ", coarse.rows, fine.rows));
+        md.push_str(&match (limit(coarse), limit(fine)) {
+            (Some(c), Some(f)) => {
+                let (mid, least, most) = step(c, f);
+                format!("{} ({}…{})", signed(mid), signed(least), signed(most))
+            }
+            _ => "—".into(),
+        });
+        md.push_str(" | |");
+        for &v in speeds {
+            let at = |r: &Rung| residual_at(&r.study, v).filter(|&x| x > 0.0);
+            md.push_str(&match (at(coarse), at(fine)) {
+                (Some(c), Some(f)) => format!(" {} |", signed(step((c, 0.0), (f, 0.0)).0)),
+                _ => " — |".into(),
+            });
+        }
+        md.push_str(" | |\n");
+    }
     (md, csv)
 }
 
@@ -1147,7 +1182,9 @@ pub fn write_ladder_files(
     let (md, csv) = ladder_table(rungs, speeds);
     let mut text = format!("# Ballistic study at {} resolutions\n\n{header}\n\n{md}\n", rungs.len());
     text.push_str(
-        "Spread: (max − min) / mean over the resolutions. Each resolution's own table, report and plot are in \
+        "Spread: (max − min) / mean over the resolutions. Step: the change from the second-finest resolution to \
+         the finest, relative to the former (for a limit, with the least and most it can be within the two \
+         brackets). Each resolution's own table, report and plot are in \
          `rows-N/` (its `--set` overrides in its header).\n\n",
     );
     for r in rungs {
@@ -1381,14 +1418,31 @@ mod tests {
         let rungs = [rung(12, (119.0, 121.0), perf(100.0), 250.0), rung(24, (129.0, 131.0), perf(110.0), 250.0)];
         let (md, csv) = ladder_table(&rungs, &[200.0, 300.0]);
         // limits 120 and 130: 10/125 = 8.0 %; at 200 m/s 100 and 110: 10/105 = 9.5 %; at 300 m/s 0 %
-        let last = md.lines().last().unwrap();
-        assert!(last.contains("| 8.0 % |") && last.contains("| 9.5 % |") && last.contains("| 0.0 % |"), "{md}");
+        let spread_row = md.lines().find(|l| l.starts_with("| spread")).unwrap();
+        assert!(
+            spread_row.contains("| 8.0 % |") && spread_row.contains("| 9.5 % |") && spread_row.contains("| 0.0 % |"),
+            "{md}"
+        );
+        // From 12 to 24 rows: the limit 120 ± 1 → 130 ± 1 is +8.3 %, and
+        // between +6.6 % (121 → 129) and +10.1 % (119 → 131); 100 → 110 m/s
+        // is +10.0 %.
+        let step_row = md.lines().last().unwrap();
+        assert!(step_row.starts_with("| step 12 → 24 rows |"), "{md}");
+        assert!(step_row.contains("| +8.3 % (+6.6 %…+10.1 %) |") && step_row.contains("| +10.0 % |"), "{step_row}");
         assert!(md.contains("| 12 | 1.000 | 120.00 ± 1.00 |"), "{md}");
         assert_eq!(csv.lines().count(), 3, "{csv}");
         assert!(csv.lines().nth(2).unwrap().starts_with("24,0.500000,130.000,1.000,,,,110.000,250.000,2,"), "{csv}");
         // A held run has no residual to compare: "held", and no spread at that speed.
         let rungs = [rung(12, (119.0, 121.0), held, 250.0), rung(24, (129.0, 131.0), perf(110.0), 250.0)];
         let (md, _) = ladder_table(&rungs, &[200.0]);
-        assert!(md.contains("| held |") && md.lines().last().unwrap().contains("| 8.0 % | | — |"), "{md}");
+        assert!(md.contains("| held |") && md.contains("| 8.0 % | | — |"), "{md}");
+        // The step is between the two finest rungs whatever the order given.
+        let rungs = [
+            rung(48, (124.0, 126.0), perf(100.0), 250.0),
+            rung(12, (119.0, 121.0), perf(100.0), 250.0),
+            rung(24, (129.0, 131.0), perf(110.0), 250.0),
+        ];
+        let (md, _) = ladder_table(&rungs, &[300.0]);
+        assert!(md.lines().last().unwrap().starts_with("| step 24 → 48 rows | | -3.8 % ("), "{md}");
     }
 }

@@ -136,7 +136,8 @@ enum Command {
         /// through the first deformable body's thickness (comma-separated,
         /// e.g. 12,24,48; every deformable body refined by the same factor),
         /// each into rows-N/, and write convergence.md/.csv/.png with the
-        /// limit and the residuals side by side and their spread.
+        /// limit and the residuals side by side, their spread and the last
+        /// refinement's step (coarsest first, each resolution once).
         #[arg(long, value_delimiter = ',')]
         rows: Vec<usize>,
         /// Continue a study in --out: a speed whose run finished there with the same case (its
@@ -601,8 +602,12 @@ fn ballistic(
             );
         }
     }
-    // Every resolution is checked before the first run starts.
-    let resolutions = args.rows.iter().map(|&r| Ok((r, at_rows(&case, r)?))).collect::<Result<Vec<_>>>()?;
+    // Every resolution is checked before the first run starts; the coarsest
+    // runs first (its answer comes soonest), each once.
+    let mut rows = args.rows.clone();
+    rows.sort_unstable();
+    rows.dedup();
+    let resolutions = rows.iter().map(|&r| Ok((r, at_rows(&case, r)?))).collect::<Result<Vec<_>>>()?;
     let experiments = match &args.experiments {
         Some(p) => read_experiments(p)?,
         None => Vec::new(),

@@ -203,7 +203,8 @@ fn the_command_runs_the_study_at_each_resolution() {
             .unwrap()
     };
     let out = dir.join("out");
-    let o = plugsim(&["--rows", "5,9", "--speeds", "500", "--out", out.to_str().unwrap()]);
+    // Given out of order and twice: run coarsest first, each once.
+    let o = plugsim(&["--rows", "9,5,9", "--speeds", "500", "--out", out.to_str().unwrap()]);
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{stderr}");
     for rows in [5, 9] {
@@ -213,6 +214,7 @@ fn the_command_runs_the_study_at_each_resolution() {
     let md = std::fs::read_to_string(out.join("convergence.md")).unwrap();
     assert!(md.contains("| 5 | 0.800 |") && md.contains("| 9 | 0.444 |") && md.contains("| spread |"), "{md}");
     assert!(md.contains("bodies.plate.rectangle.layers=5"), "{md}");
+    assert!(md.find("| 5 | 0.800 |") < md.find("| 9 | 0.444 |") && md.contains("| step 5 → 9 rows |"), "{md}");
     assert_eq!(std::fs::read_to_string(out.join("convergence.csv")).unwrap().lines().count(), 3);
     assert!(out.join("convergence.png").exists());
     // 1 row is no plate: refused, nothing run.
