@@ -1067,10 +1067,15 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
     md.push_str(&"---|".repeat(speeds.len() + 2));
     md.push('\n');
     csv.push_str(",runs,wall_s\n");
+    // Each rung's limit (value, half-width) if bracketed, its residual at a
+    // speed, and that residual where it perforated (the spread and the step
+    // compare those only).
+    let limit_of = |st: &Study| st.limit.as_ref().and_then(|l| l.estimate());
     let residual_at = |st: &Study, v: Real| st.shots.iter().find(|s| s.speed == v).and_then(|s| s.residual());
+    let perforated_at = |st: &Study, v: Real| residual_at(st, v).filter(|&x| x > 0.0);
     for r in rungs {
         let st = &r.study;
-        let limit = st.limit.as_ref().and_then(|l| l.estimate());
+        let limit = limit_of(st);
         let wall: Real = st.shots.iter().map(|s| s.wall).sum();
         md.push_str(&format!(
             "| {} | {:.3} | {} | {} |",
@@ -1102,14 +1107,13 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
         csv.push_str(&format!(",{},{wall:.2}\n", st.shots.len()));
     }
     let pct = |s: Option<Real>| s.map_or("—".into(), |x| format!("{:.1} %", 100.0 * x));
-    let limits: Vec<Real> =
-        rungs.iter().filter_map(|r| r.study.limit.as_ref().and_then(|l| l.estimate()).map(|e| e.0)).collect();
+    let limits: Vec<Real> = rungs.iter().filter_map(|r| limit_of(&r.study).map(|e| e.0)).collect();
     md.push_str(&format!(
         "| spread | | {} | |",
         if limits.len() == rungs.len() { pct(spread(&limits)) } else { "—".into() }
     ));
     for &v in speeds {
-        let vr: Option<Vec<Real>> = rungs.iter().map(|r| residual_at(&r.study, v).filter(|&x| x > 0.0)).collect();
+        let vr: Option<Vec<Real>> = rungs.iter().map(|r| perforated_at(&r.study, v)).collect();
         md.push_str(&format!(" {} |", pct(vr.and_then(|x| spread(&x)))));
     }
     md.push_str(" | |\n");
@@ -1118,9 +1122,8 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
     by_rows.sort_by_key(|r| r.rows);
     if let [.., coarse, fine] = by_rows[..] {
         let signed = |x: Real| format!("{:+.1} %", 100.0 * x);
-        let limit = |r: &Rung| r.study.limit.as_ref().and_then(|l| l.estimate());
         md.push_str(&format!("| step {} → {} rows | | ", coarse.rows, fine.rows));
-        md.push_str(&match (limit(coarse), limit(fine)) {
+        md.push_str(&match (limit_of(&coarse.study), limit_of(&fine.study)) {
             (Some(c), Some(f)) => {
                 let (mid, least, most) = step(c, f);
                 format!("{} ({}…{})", signed(mid), signed(least), signed(most))
@@ -1129,8 +1132,7 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
         });
         md.push_str(" | |");
         for &v in speeds {
-            let at = |r: &Rung| residual_at(&r.study, v).filter(|&x| x > 0.0);
-            md.push_str(&match (at(coarse), at(fine)) {
+            md.push_str(&match (perforated_at(&coarse.study, v), perforated_at(&fine.study, v)) {
                 (Some(c), Some(f)) => format!(" {} |", signed(step((c, 0.0), (f, 0.0)).0)),
                 _ => " — |".into(),
             });
