@@ -58,6 +58,7 @@
 //!   flight, and those only up to their checkpoint.
 
 use crate::case::Case;
+use crate::convergence::{self, richardson, spread, step};
 use crate::io::{IoError, LinePlot, PlotError, Series};
 use crate::math::{Real, Vec2};
 use crate::residual::Verdict;
@@ -415,6 +416,24 @@ pub struct Study {
     pub limit: Option<Limit>,
     /// Recht–Ipson fit of the perforating points.
     pub fit: Option<RechtIpson>,
+}
+
+impl Study {
+    /// The limit as the runs read it: the search's, or in a study of
+    /// speeds alone (no `--limit`) the bracket its runs give once they
+    /// hold at one speed and perforate at a higher one ([`bracket`]; `tol`
+    /// NaN: no tolerance was asked for).
+    pub fn limit_reading(&self) -> Option<Limit> {
+        self.limit.clone().or_else(|| {
+            let (held, perforated, above) = bracket(&self.shots);
+            (held.is_some() && perforated.is_some()).then_some(Limit {
+                held,
+                perforated,
+                tol: Real::NAN,
+                non_monotonic: above,
+            })
+        })
+    }
 }
 
 /// The ballistic limit from the search.
@@ -925,8 +944,14 @@ pub fn report(header: &str, study: &Study) -> String {
     if study.interrupted {
         s.push_str("**Interrupted**: the table holds the runs finished before the interrupt.\n\n");
     }
-    if let Some(l) = &study.limit {
+    if let Some(l) = &study.limit_reading() {
         match (l.estimate(), l.held, l.perforated) {
+            (Some((v, h)), _, _) if l.tol.is_nan() => s.push_str(&format!(
+                "Ballistic limit from the speeds run (no search): **v_bl = {v:.2} ± {h:.2} m/s** (held at {:.2}, \
+                 perforated at {:.2} m/s).\n\n",
+                l.held.unwrap_or(0.0),
+                l.perforated.unwrap_or(0.0),
+            )),
             (Some((v, h)), _, _) => s.push_str(&format!(
                 "Ballistic limit: **v_bl = {v:.2} ± {h:.2} m/s** (held at {:.2}, perforated at {:.2} m/s; tolerance ±{} m/s{}).\n\n",
                 l.held.unwrap_or(0.0),
@@ -1030,32 +1055,18 @@ pub struct Rung {
     pub study: Study,
 }
 
-/// `(max − min) / mean` of `values` (`None` for fewer than two).
-pub fn spread(values: &[Real]) -> Option<Real> {
-    if values.len() < 2 {
-        return None;
-    }
-    let (lo, hi) = values.iter().fold((Real::MAX, Real::MIN), |(a, b), &x| (a.min(x), b.max(x)));
-    Some((hi - lo) / (values.iter().sum::<Real>() / values.len() as Real))
-}
-
-/// The change from `coarse` to `fine` relative to `coarse`, each given as
-/// (value, half-width of its bracket): (central, least, most), the least and
-/// most being the change when each value may lie anywhere in its bracket
-/// (a residual velocity has half-width 0, a ballistic limit its bisection's).
-pub fn step(coarse: (Real, Real), fine: (Real, Real)) -> (Real, Real, Real) {
-    let ((c, hc), (f, hf)) = (coarse, fine);
-    ((f - c) / c, (f - hf - (c + hc)) / (c + hc), (f + hf - (c - hc)) / (c - hc))
-}
-
 /// The resolutions side by side, as (Markdown, CSV): per rung the ballistic
 /// limit, the Recht–Ipson fit and the residual velocity at each of
-/// `speeds`, then the spread of each across the rungs ([`spread`]) and the
+/// `speeds`, then the spread of each across the rungs ([`spread`]), the
 /// last refinement's [`step`] (from the second-finest rung to the finest:
-/// what one more refinement moved, the usual test of a converged result);
-/// the limit's spread and step count only bracketed limits, a residual's
-/// only if every rung perforated at that speed (a held run is 0 m/s, which
-/// no spread describes: the Markdown says "held").
+/// what one more refinement moved, the usual test of a converged result)
+/// and, with three rungs or more, what the three finest say of the answer
+/// at zero spacing ([`richardson`]: the observed order, the extrapolated
+/// value and the finest rung's grid convergence index, or why there is
+/// none); the limit's spread, step and extrapolation count only bracketed
+/// limits (with their brackets), a residual's only if every rung
+/// perforated at that speed (a held run is 0 m/s, which no spread
+/// describes: the Markdown says "held").
 pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
     let mut md = String::from("| rows | spacing (mm) | v_bl (m/s) | Recht–Ipson a, p, v_bl |");
     let mut csv = String::from("rows,spacing_mm,v_bl_m_s,v_bl_half_width_m_s,a,p,fit_v_bl_m_s");
@@ -1070,7 +1081,7 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
     // Each rung's limit (value, half-width) if bracketed, its residual at a
     // speed, and that residual where it perforated (the spread and the step
     // compare those only).
-    let limit_of = |st: &Study| st.limit.as_ref().and_then(|l| l.estimate());
+    let limit_of = |st: &Study| st.limit_reading().and_then(|l| l.estimate());
     let residual_at = |st: &Study, v: Real| st.shots.iter().find(|s| s.speed == v).and_then(|s| s.residual());
     let perforated_at = |st: &Study, v: Real| residual_at(st, v).filter(|&x| x > 0.0);
     for r in rungs {
@@ -1139,6 +1150,25 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
         }
         md.push_str(" | |\n");
     }
+    if let [.., third, second, first] = by_rows[..] {
+        let three = [third, second, first];
+        let ladder = |value: &dyn Fn(&Rung) -> Option<(Real, Real)>| -> Option<Vec<convergence::Rung>> {
+            three
+                .iter()
+                .map(|r| {
+                    value(r).map(|(value, half_width)| convergence::Rung { spacing: r.spacing, value, half_width })
+                })
+                .collect()
+        };
+        md.push_str(&format!("| Richardson, {} / {} / {} rows | | ", third.rows, second.rows, first.rows));
+        md.push_str(&convergence::describe(ladder(&|r| limit_of(&r.study)).and_then(|l| richardson(&l))));
+        md.push_str(" | |");
+        for &v in speeds {
+            let rungs = ladder(&|r| perforated_at(&r.study, v).map(|x| (x, 0.0)));
+            md.push_str(&format!(" {} |", convergence::describe(rungs.and_then(|l| richardson(&l)))));
+        }
+        md.push_str(" | |\n");
+    }
     (md, csv)
 }
 
@@ -1186,7 +1216,11 @@ pub fn write_ladder_files(
     text.push_str(
         "Spread: (max − min) / mean over the resolutions. Step: the change from the second-finest resolution to \
          the finest, relative to the former (for a limit, with the least and most it can be within the two \
-         brackets). Each resolution's own table, report and plot are in \
+         brackets). Richardson (three resolutions or more): from the three finest, the observed order of \
+         convergence p, the value extrapolated to zero spacing and the grid convergence index of the finest \
+         (1.25 |finest − next| / (r^p − 1) relative to the finest, r the spacing ratio; Celik et al. 2008), given \
+         only when the two steps have one sign and the last is the smaller (else it says why not); a limit's \
+         step within its brackets gives none. Each resolution's own table, report and plot are in \
          `rows-N/` (its `--set` overrides in its header).\n\n",
     );
     for r in rungs {
@@ -1331,8 +1365,19 @@ mod tests {
             text.contains("Zone of mixed results: the plate held at 128.40 m/s") && text.contains("(123.33 m/s)"),
             "{text}"
         );
-        let monotone = Study { limit: Some(Limit { non_monotonic: None, ..study.limit.clone().unwrap() }), ..study };
+        let monotone =
+            Study { limit: Some(Limit { non_monotonic: None, ..study.limit.clone().unwrap() }), ..study.clone() };
         assert!(!report("header", &monotone).contains("mixed results"));
+        // A study of speeds alone (no search) reads the same bracket and
+        // zone from its runs, without a tolerance.
+        let scan = Study { limit: None, ..study.clone() };
+        let text = report("header", &scan);
+        assert!(text.contains("from the speeds run (no search): **v_bl = 122.59 ± 0.74 m/s**"), "{text}");
+        assert!(text.contains("Zone of mixed results: the plate held at 128.40 m/s") && !text.contains("tolerance"));
+        // Only once both sides are there.
+        let perforated = Study { shots: study.shots[1..2].to_vec(), limit: None, ..study.clone() };
+        assert_eq!(perforated.limit_reading(), None);
+        assert!(!report("header", &perforated).contains("**v_bl"));
     }
 
     #[test]
@@ -1445,6 +1490,34 @@ mod tests {
             rung(24, (129.0, 131.0), perf(110.0), 250.0),
         ];
         let (md, _) = ladder_table(&rungs, &[300.0]);
-        assert!(md.lines().last().unwrap().starts_with("| step 24 → 48 rows | | -3.8 % ("), "{md}");
+        assert!(md.contains("| step 24 → 48 rows | | -3.8 % ("), "{md}");
+        // Three rungs: the limits 120, 130, 125 swing, and the residuals
+        // at 300 m/s do not move: no order from either.
+        let rich = md.lines().last().unwrap();
+        assert!(rich.starts_with("| Richardson, 12 / 24 / 48 rows | | steps change sign: no order |"), "{md}");
+        assert!(rich.contains("| a step within the brackets: no order |"), "{rich}");
+        // Case I's plate at 24 / 48 / 96 rows (docs/validation.md): limits
+        // 123.14 / 115.75 / 113.39 ± 1 m/s fall by 7.39 then 2.36 m/s, a
+        // ratio of 3.131 = 2^1.647, so v_bl(0) = 113.39 − 2.36 / 2.131 =
+        // 112.28 m/s and GCI = 1.25 × 2.36 / 113.39 / 2.131 = 1.2 %; the
+        // residuals at 200 m/s, 153.42 / 155.34 / 156.34, give p = 0.94,
+        // 157.43 m/s, GCI 0.9 %.
+        let rungs = [
+            rung(24, (122.14, 124.14), perf(153.42), 250.0),
+            rung(48, (114.75, 116.75), perf(155.34), 250.0),
+            rung(96, (112.39, 114.39), perf(156.34), 250.0),
+        ];
+        let (md, _) = ladder_table(&rungs, &[200.0]);
+        let rich = md.lines().last().unwrap();
+        assert!(rich.contains("| p = 1.65, 112.28, GCI 1.2 % |"), "{rich}");
+        assert!(rich.contains("| p = 0.94, 157.43, GCI 0.9 % |"), "{rich}");
+        // A last step within the brackets (±1.5 m/s here) gives none.
+        let mut wide = rungs.clone();
+        wide[2].study.limit.as_mut().unwrap().held = Some(111.89);
+        wide[2].study.limit.as_mut().unwrap().perforated = Some(114.89);
+        wide[1].study.limit.as_mut().unwrap().held = Some(114.25);
+        wide[1].study.limit.as_mut().unwrap().perforated = Some(117.25);
+        let (md, _) = ladder_table(&wide, &[200.0]);
+        assert!(md.lines().last().unwrap().contains("| a step within the brackets: no order |"), "{md}");
     }
 }

@@ -9,6 +9,7 @@ pub mod case;
 pub mod cases;
 pub mod checkpoint;
 pub mod contact;
+pub mod convergence;
 pub mod discretize;
 pub mod fracture;
 pub mod geometry;

@@ -285,21 +285,39 @@ pub fn rung(coarse: &Row, layers: usize) -> (Row, Vec<String>) {
 /// resolutions, in that order.
 pub type Ladder = (Row, Vec<Outcome>);
 
+/// The residual velocities over a ladder, if every rung perforated.
+fn perforating_residuals(outcomes: &[Outcome]) -> Option<Vec<Real>> {
+    outcomes.iter().map(|o| o.residual().filter(|&r| r > 0.0)).collect()
+}
+
 /// `(max − min) / mean` of the residual velocities over a ladder, if every
 /// rung perforated.
 pub fn residual_spread(outcomes: &[Outcome]) -> Option<Real> {
-    let v: Vec<Real> = outcomes.iter().map(|o| o.residual().filter(|&r| r > 0.0)).collect::<Option<_>>()?;
-    crate::ballistic::spread(&v)
+    crate::convergence::spread(&perforating_residuals(outcomes)?)
+}
+
+/// What the ladder's residual velocities say of the answer at zero spacing
+/// ([`crate::convergence::richardson`]; the rungs' spacings halve, as
+/// their rows double), if every rung perforated.
+pub fn residual_richardson(outcomes: &[Outcome]) -> Option<crate::convergence::Asymptotic> {
+    let v = perforating_residuals(outcomes)?;
+    let rungs: Vec<_> = LADDER
+        .iter()
+        .zip(v)
+        .map(|(&rows, value)| crate::convergence::Rung { spacing: 1.0 / rows as Real, value, half_width: 0.0 })
+        .collect();
+    crate::convergence::richardson(&rungs)
 }
 
 /// The convergence table as Markdown and CSV: per ladder, the residual
 /// velocity, perforation time, plug mass and fastest particle at each
-/// resolution, the spread of the residuals and the finest one's error
+/// resolution, the spread of the residuals, what they say of the answer at
+/// zero spacing ([`residual_richardson`]) and the finest one's error
 /// against the experiment.
 pub fn convergence_table(ladders: &[Ladder]) -> (String, String) {
     let rows = |f: &dyn Fn(&Outcome) -> String, os: &[Outcome]| os.iter().map(f).collect::<Vec<_>>().join(" / ");
     let mut md = String::from(
-        "| case | criterion | residual at 12 / 24 / 48 rows (m/s) | spread % | experiment (m/s) | error at 48 rows % | perforation (µs) | plug (g) | fastest particle (m/s) | smallest step / spacing step | wall (s) |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| case | criterion | residual at 12 / 24 / 48 rows (m/s) | spread % | Richardson: order, extrapolated (m/s), GCI | experiment (m/s) | error at 48 rows % | perforation (µs) | plug (g) | fastest particle (m/s) | smallest step / spacing step | wall (s) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let mut csv = String::from(
         "case,criterion,rows,residual_m_s,outcome,experiment_m_s,perforation_us,plug_g,fastest_m_s,smallest_step_ratio,wall_s\n",
@@ -320,11 +338,12 @@ pub fn convergence_table(ladders: &[Ladder]) -> (String, String) {
         let e = row.experiment;
         let finest = os.last().and_then(|o| o.residual()).filter(|&r| r > 0.0);
         md.push_str(&format!(
-            "| {} | {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} |\n",
             e.name,
             row.case.criterion,
             rows(&residual, os),
             residual_spread(os).map_or_else(|| "—".into(), |s| format!("{:.1}", 100.0 * s)),
+            crate::convergence::describe(residual_richardson(os)),
             e.residual,
             finest.map_or_else(|| "—".into(), |r| format!("{:+.1}", 100.0 * (r - e.residual) / e.residual)),
             rows(&|o| fmt_opt(o.perforation().map(|t| t * 1e6), 1), os),
