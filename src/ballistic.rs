@@ -86,6 +86,45 @@ pub fn default_max_time(case: &Case) -> Real {
     DECIDE_FACTOR * case.time.end
 }
 
+/// The most speeds one `LO:HI:STEP` item of [`parse_speeds`] may give.
+pub const MAX_SPEEDS_PER_RANGE: usize = 1000;
+
+/// One comma-separated item of `plugsim ballistic --speeds`: a speed, or an
+/// inclusive range `LO:HI:STEP` (`116:134:1`: 116, 117, …, 134 m/s; the
+/// last speed is the highest `LO + k STEP` not above `HI`, to within 10⁻⁹
+/// of STEP, each rounded to 10⁻⁶ m/s so that a run's directory name is the
+/// speed typed). Every speed must be a positive number; a range needs
+/// `HI ≥ LO`, `STEP > 0` and at most [`MAX_SPEEDS_PER_RANGE`] speeds. The
+/// error names the item, for the command line.
+pub fn parse_speeds(item: &str) -> Result<Vec<Real>, String> {
+    let number = |t: &str| -> Result<Real, String> {
+        t.trim()
+            .parse::<Real>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("'{t}' in '{item}' is not a number"))
+    };
+    let speeds = match item.split(':').collect::<Vec<_>>()[..] {
+        [v] => vec![number(v)?],
+        [lo, hi, step] => {
+            let (lo, hi, step) = (number(lo)?, number(hi)?, number(step)?);
+            if step <= 0.0 || hi < lo {
+                return Err(format!("range '{item}' needs LO <= HI and STEP > 0 (LO:HI:STEP)"));
+            }
+            let n = ((hi - lo) / step + 1e-9).floor();
+            if n >= MAX_SPEEDS_PER_RANGE as Real {
+                return Err(format!("range '{item}' gives more than {MAX_SPEEDS_PER_RANGE} speeds"));
+            }
+            (0..=n as usize).map(|k| ((lo + k as Real * step) * 1e6).round() / 1e6).collect()
+        }
+        _ => return Err(format!("'{item}' is neither a speed nor a range LO:HI:STEP")),
+    };
+    match speeds.iter().find(|v| **v <= 0.0) {
+        Some(v) => Err(format!("impact speeds must be positive (got {v} in '{item}')")),
+        None => Ok(speeds),
+    }
+}
+
 /// How many times the search moves a bound that does not bracket the limit.
 pub const WIDEN_TRIES: usize = 3;
 
@@ -1267,6 +1306,35 @@ pub fn write_files(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `--speeds` items: a speed, an inclusive range, and each malformed
+    /// item refused naming it.
+    #[test]
+    fn speeds_are_read_as_values_or_ranges() {
+        assert_eq!(parse_speeds("173.7"), Ok(vec![173.7]));
+        assert_eq!(parse_speeds("116:120:1"), Ok(vec![116.0, 117.0, 118.0, 119.0, 120.0]));
+        // The end is kept when the steps reach it only to rounding, and the
+        // speeds are the decimal ones (0.1 is not exact in binary).
+        let v = parse_speeds("110:111:0.1").unwrap();
+        assert_eq!(v.len(), 11);
+        assert_eq!((v[3], v[10]), (110.3, 111.0));
+        // A step that passes the end stops below it.
+        assert_eq!(parse_speeds("100:110:4"), Ok(vec![100.0, 104.0, 108.0]));
+        assert_eq!(parse_speeds("120:120:5"), Ok(vec![120.0]));
+        for (bad, says) in [
+            ("fast", "'fast' in 'fast' is not a number"),
+            ("120:110:1", "needs LO <= HI"),
+            ("110:120:0", "STEP > 0"),
+            ("110:120", "neither a speed nor a range"),
+            ("1:100000:1", "more than 1000 speeds"),
+            ("-5", "must be positive"),
+            ("0:10:5", "must be positive (got 0 in '0:10:5')"),
+            ("inf", "not a number"),
+        ] {
+            let e = parse_speeds(bad).unwrap_err();
+            assert!(e.contains(says), "{bad}: {e}");
+        }
+    }
 
     fn synthetic(a: Real, p: Real, v_bl: Real, speeds: &[Real]) -> Vec<(Real, Real)> {
         speeds.iter().map(|&v| (v, recht_ipson(v, a, p, v_bl))).collect()

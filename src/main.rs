@@ -97,9 +97,10 @@ enum Command {
         /// A built-in case by name (see `plugsim cases`).
         #[arg(long, conflicts_with = "case_file")]
         case: Option<String>,
-        /// Impact speeds to run, m/s (comma-separated).
-        #[arg(long, value_delimiter = ',')]
-        speeds: Vec<f64>,
+        /// Impact speeds to run, m/s: comma-separated, each a speed or an inclusive range
+        /// LO:HI:STEP (e.g. --speeds 116:134:1,140,150).
+        #[arg(long, value_delimiter = ',', value_parser = speed_item)]
+        speeds: Vec<SpeedItem>,
         /// Find the ballistic limit by bisection.
         #[arg(long)]
         limit: bool,
@@ -294,6 +295,7 @@ fn dispatch(cmd: Command) -> Result<()> {
             resume,
         } => {
             let (case, name, file) = load(&case_file, &case, &set)?;
+            let speeds = speeds.into_iter().flat_map(|s| s.0).collect();
             let args =
                 BallisticArgs { speeds, limit, lo, hi, tol, max_time, projectile, jobs, experiments, rows, resume };
             ballistic(case, &name, &file, &set, out, args)
@@ -563,6 +565,15 @@ fn validate_taylor(out: &Path, all: bool, only: Option<&str>, set: &[String]) ->
     Ok(())
 }
 
+/// One item of `--speeds` (a speed or a range), read by
+/// [`plugsim::ballistic::parse_speeds`].
+#[derive(Clone, Debug)]
+struct SpeedItem(Vec<f64>);
+
+fn speed_item(item: &str) -> Result<SpeedItem, String> {
+    plugsim::ballistic::parse_speeds(item).map(SpeedItem)
+}
+
 /// `plugsim ballistic`'s options besides the case.
 struct BallisticArgs {
     speeds: Vec<f64>,
@@ -590,9 +601,6 @@ fn ballistic(
     let projectile = select_projectile(&case, file, args.projectile.as_deref())?;
     if args.speeds.is_empty() && !args.limit {
         bail!("give --speeds V1,V2,... and/or --limit");
-    }
-    if let Some(v) = args.speeds.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
-        bail!("impact speeds must be positive numbers (got {v})");
     }
     if let Some(t) = args.max_time {
         if !(t.is_finite() && t >= case.time.end) {
@@ -638,12 +646,17 @@ fn ballistic(
         }
     }
     let header = format!(
-        "Case {file}{}, produced by `plugsim ballistic --rows` ({} {}) on {}; total wall time {:.0} s.",
+        "Case {file}{}, produced by `plugsim ballistic --rows` ({} {}) on {}; total wall time {:.0} s{}.",
         if set.is_empty() { String::new() } else { format!(" with {}", set.join(" ")) },
         env!("CARGO_PKG_VERSION"),
         env!("PLUGSIM_COMMIT"),
         cpu_name(),
-        started.elapsed().as_secs_f64()
+        started.elapsed().as_secs_f64(),
+        if args.resume {
+            " (this command's; the runs taken back by --resume count in the wall column only)"
+        } else {
+            ""
+        }
     );
     let title = format!("{}: v_r against v_i at {} resolutions", case.title, rungs.len());
     let files = write_ladder_files(&out_dir, &header, &title, &rungs, &args.speeds, &experiments)?;

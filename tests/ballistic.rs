@@ -233,6 +233,11 @@ fn the_command_runs_the_study_at_each_resolution() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && stderr.contains("--max-time must be at least"), "{stderr}");
     assert!(!bad.exists(), "refused before any run");
+    // A range of speeds that runs backwards is refused, naming the option.
+    let o = plugsim(&["--speeds", "400,520:500:10", "--out", bad.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && stderr.contains("--speeds") && stderr.contains("'520:500:10'"), "{stderr}");
+    assert!(!bad.exists(), "refused before any run");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
