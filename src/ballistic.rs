@@ -970,10 +970,11 @@ projectile's speed along its flight fell to 1 % of the impact speed or below (st
 v_r = 0. Each run stops 20 us after either (`time.stop_after_release`); one still undecided at the case's \
 end time goes on, up to `--max-time` (default 3 times the case's end time). A run still undecided at its end \
 counts as perforating if a plug was cut out, else as held. Ballistic limit: \
-between the highest speed held and the lowest perforating; each search round runs as many speeds as run \
-side by side, evenly spaced inside the bracket. Recht-Ipson: v_r = a (v_i^p - v_bl^p)^(1/p), least squares \
-over the perforating runs with v_bl between the highest held speed and the lowest perforating one (p = 2 \
-with fewer than three points).";
+between the lowest perforating speed and the highest speed held below it (one held above it marks a zone of \
+mixed results); each search round runs as many speeds as run side by side, evenly spaced inside the \
+bracket. A search assumes the outcome changes once with the speed; a scan at small steps \
+(`--speeds LO:HI:STEP`) shows whether it does. Recht-Ipson: v_r = a (v_i^p - v_bl^p)^(1/p), least squares \
+over the perforating runs with v_bl within the limit's bracket (p = 2 with fewer than three points).";
 
 /// The Markdown report: `header` (case, settings, provenance), the table,
 /// the limit, the fit, the definitions and the plot.
@@ -1435,7 +1436,7 @@ mod tests {
         );
         let monotone =
             Study { limit: Some(Limit { non_monotonic: None, ..study.limit.clone().unwrap() }), ..study.clone() };
-        assert!(!report("header", &monotone).contains("mixed results"));
+        assert!(!report("header", &monotone).contains("Zone of mixed results"));
         // A study of speeds alone (no search) reads the same bracket and
         // zone from its runs, without a tolerance.
         let scan = Study { limit: None, ..study.clone() };
