@@ -459,13 +459,14 @@ pub struct Study {
 
 impl Study {
     /// The limit as the runs read it: the search's, or in a study of
-    /// speeds alone (no `--limit`) the bracket its runs give once they
-    /// hold at one speed and perforate at a higher one ([`bracket`]; `tol`
-    /// NaN: no tolerance was asked for).
+    /// speeds alone (no `--limit`) the bracket its runs give ([`bracket`];
+    /// `tol` NaN: no tolerance was asked for). A side is missing where no
+    /// run gives it (every run held, or none held below the perforating
+    /// ones); `None` only without a finished run.
     pub fn limit_reading(&self) -> Option<Limit> {
         self.limit.clone().or_else(|| {
             let (held, perforated, above) = bracket(&self.shots);
-            (held.is_some() && perforated.is_some()).then_some(Limit {
+            (held.is_some() || perforated.is_some()).then_some(Limit {
                 held,
                 perforated,
                 tol: Real::NAN,
@@ -1000,7 +1001,10 @@ pub fn report(header: &str, study: &Study) -> String {
                 if h > l.tol { ", not reached" } else { "" }
             )),
             (None, Some(lo), None) => s.push_str(&format!("Ballistic limit not bracketed: every speed held, up to {lo:.2} m/s.\n\n")),
-            (None, None, Some(hi)) => s.push_str(&format!("Ballistic limit not bracketed: every speed perforated, down to {hi:.2} m/s.\n\n")),
+            (None, None, Some(hi)) => s.push_str(&format!(
+                "Ballistic limit not bracketed: no speed held below {hi:.2} m/s, the lowest perforating one; the \
+                 limit is below it.\n\n"
+            )),
             _ => s.push_str("Ballistic limit: no finished runs.\n\n"),
         }
         let undecided = study
@@ -1026,15 +1030,24 @@ pub fn report(header: &str, study: &Study) -> String {
             ));
         }
     }
+    // Without a held run below the perforating ones nothing bounds the
+    // fit's v_bl from below but zero: it extrapolates the curve.
+    let unbounded = study.limit_reading().is_none_or(|l| l.held.is_none());
     match &study.fit {
         Some(f) => s.push_str(&format!(
-            "Recht–Ipson fit over {} perforating runs: a = {:.4}, p = {:.3}{}, v_bl = {:.2} m/s (rms residual {:.2} m/s).\n\n",
+            "Recht–Ipson fit over {} perforating runs: a = {:.4}, p = {:.3}{}, v_bl = {:.2} m/s (rms residual {:.2} m/s){}.\n\n",
             f.points,
             f.a,
             f.p,
             if f.p_fixed { " (held)" } else { "" },
             f.v_bl,
-            f.rms
+            f.rms,
+            if unbounded {
+                "; no run held below the perforating ones, so this v_bl extrapolates the curve (bounded by 0 only) \
+                 and is not a ballistic limit: run slower speeds to bracket it"
+            } else {
+                ""
+            }
         )),
         None => s.push_str("Recht–Ipson fit: fewer than two perforating runs.\n\n"),
     }
@@ -1443,10 +1456,19 @@ mod tests {
         let text = report("header", &scan);
         assert!(text.contains("from the speeds run (no search): **v_bl = 122.59 ± 0.74 m/s**"), "{text}");
         assert!(text.contains("Zone of mixed results: the plate held at 128.40 m/s") && !text.contains("tolerance"));
-        // Only once both sides are there.
-        let perforated = Study { shots: study.shots[1..2].to_vec(), limit: None, ..study.clone() };
-        assert_eq!(perforated.limit_reading(), None);
-        assert!(!report("header", &perforated).contains("**v_bl"));
+        // A limit only once both sides are there; with one side the report
+        // says which is missing, and a fit with nothing held below it is
+        // marked as an extrapolation.
+        let shots = vec![study.shots[1].clone(), study.shots[4].clone()];
+        let mut perforated = Study { shots, limit: None, ..study.clone() };
+        refit(&mut perforated);
+        assert!(perforated.fit.is_some());
+        assert_eq!(perforated.limit_reading().and_then(|l| l.estimate()), None);
+        let text = report("header", &perforated);
+        assert!(!text.contains("**v_bl"), "{text}");
+        assert!(text.contains("no speed held below") && text.contains("not a ballistic limit"), "{text}");
+        assert!(!report("header", &scan).contains("not a ballistic limit"));
+        assert_eq!(Study { shots: vec![], limit: None, ..study.clone() }.limit_reading(), None);
     }
 
     #[test]
