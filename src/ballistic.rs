@@ -463,6 +463,9 @@ impl Study {
     /// `tol` NaN: no tolerance was asked for). A side is missing where no
     /// run gives it (every run held, or none held below the perforating
     /// ones); `None` only without a finished run.
+    ///
+    /// [`Study::fit_unbounded`] tells whether the fit's `v_bl` has a held
+    /// run below it.
     pub fn limit_reading(&self) -> Option<Limit> {
         self.limit.clone().or_else(|| {
             let (held, perforated, above) = bracket(&self.shots);
@@ -473,6 +476,13 @@ impl Study {
                 non_monotonic: above,
             })
         })
+    }
+
+    /// Whether no run held below the perforating ones, so that nothing but
+    /// zero bounds the Recht–Ipson fit's `v_bl` from below: the fit then
+    /// extrapolates the curve and its `v_bl` is not a limit.
+    pub fn fit_unbounded(&self) -> bool {
+        self.limit_reading().is_none_or(|l| l.held.is_none())
     }
 }
 
@@ -495,6 +505,18 @@ impl Limit {
     pub fn estimate(&self) -> Option<(Real, Real)> {
         let (lo, hi) = (self.held?, self.perforated?);
         Some((0.5 * (lo + hi), 0.5 * (hi - lo)))
+    }
+
+    /// The limit for a table cell: `v ± h` once bracketed, else the side
+    /// the runs give (`< v`: nothing held below the lowest perforating
+    /// speed; `> v`: every speed held).
+    pub fn cell(&self) -> String {
+        match (self.estimate(), self.held, self.perforated) {
+            (Some((v, h)), _, _) => format!("{v:.2} ± {h:.2}"),
+            (None, _, Some(p)) => format!("< {p:.2}"),
+            (None, Some(h), None) => format!("> {h:.2}"),
+            (None, None, None) => "—".into(),
+        }
     }
 }
 
@@ -1030,9 +1052,7 @@ pub fn report(header: &str, study: &Study) -> String {
             ));
         }
     }
-    // Without a held run below the perforating ones nothing bounds the
-    // fit's v_bl from below but zero: it extrapolates the curve.
-    let unbounded = study.limit_reading().is_none_or(|l| l.held.is_none());
+    let unbounded = study.fit_unbounded();
     match &study.fit {
         Some(f) => s.push_str(&format!(
             "Recht–Ipson fit over {} perforating runs: a = {:.4}, p = {:.3}{}, v_bl = {:.2} m/s (rms residual {:.2} m/s){}.\n\n",
@@ -1145,8 +1165,14 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
             "| {} | {:.3} | {} | {} |",
             r.rows,
             r.spacing * 1e3,
-            limit.map_or("—".into(), |(v, h)| format!("{v:.2} ± {h:.2}")),
-            st.fit.map_or("—".into(), |f| format!("{:.3}, {:.2}, {:.2}", f.a, f.p, f.v_bl)),
+            st.limit_reading().map_or("—".into(), |l| l.cell()),
+            st.fit.map_or("—".into(), |f| format!(
+                "{:.3}, {:.2}, {:.2}{}",
+                f.a,
+                f.p,
+                f.v_bl,
+                if st.fit_unbounded() { " (extrapolated: no run held below)" } else { "" }
+            )),
         ));
         csv.push_str(&format!(
             "{},{:.6},{},{},{},{},{}",
@@ -1610,5 +1636,17 @@ mod tests {
         wide[1].study.limit.as_mut().unwrap().perforated = Some(117.25);
         let (md, _) = ladder_table(&wide, &[200.0]);
         assert!(md.lines().last().unwrap().contains("| a step within the brackets: no order |"), "{md}");
+        // A scan that perforated at every speed (Case II's plate at 48 rows,
+        // docs/validation.md) bounds the limit from above only: "< 200.00",
+        // its fit marked, and no spread of limits.
+        let mut scan = rungs.clone();
+        scan[2].study.limit = None;
+        scan[2].study.shots[0].verdict = perf(150.0);
+        refit(&mut scan[2].study);
+        let (md, _) = ladder_table(&scan, &[200.0]);
+        let row = md.lines().find(|l| l.starts_with("| 96 |")).unwrap();
+        assert!(row.contains("| < 200.00 |") && row.contains("(extrapolated: no run held below)"), "{row}");
+        assert!(md.lines().find(|l| l.starts_with("| spread")).unwrap().starts_with("| spread | | — |"), "{md}");
+        assert!(!md.lines().find(|l| l.starts_with("| 48 |")).unwrap().contains("extrapolated"), "{md}");
     }
 }
