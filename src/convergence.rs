@@ -199,6 +199,28 @@ mod tests {
         assert!((100.0 * e.gci_fine - 2.2).abs() < 0.05, "GCI = {} %", 100.0 * e.gci_fine);
     }
 
+    /// The 12 mm plate's limits scanned at 1 m/s steps (docs/validation.md,
+    /// "Sharp and mixed limits"): 136.50 / 125.50 / 119.50 ± 0.50 m/s at
+    /// 12 / 24 / 48 rows. The steps −11 and −6 give `2ᵖ = 11/6`, so
+    /// `p = log₂(11/6) = 0.874`, `φ_ext = 119.5 − 6 / (5/6) = 112.30` and
+    /// `GCI = 1.25 × 7.2 / 119.5 = 7.53 %`. Case I's and Case II's
+    /// scanned ladders (124.50 / 122.50 / 115.75 and 123.50 / 121.50 /
+    /// 118.15 ± 0.74) have steps that grow.
+    #[test]
+    fn the_scanned_ladders_by_hand() {
+        let limits = |v: [Real; 3], h: [Real; 3]| -> Vec<Rung> {
+            (0..3).map(|i| Rung { spacing: 4.0 / (1 << i) as Real, value: v[i], half_width: h[i] }).collect()
+        };
+        let Some(Asymptotic::Converging(e)) = richardson(&limits([136.5, 125.5, 119.5], [0.5; 3])) else {
+            panic!("not converging")
+        };
+        assert!((e.order - (11.0 / 6.0 as Real).log2()).abs() < 1e-9, "p = {}", e.order);
+        assert!((e.extrapolated - 112.3).abs() < 1e-9, "φ_ext = {}", e.extrapolated);
+        assert!((e.gci_fine - 1.25 * 7.2 / 119.5).abs() < 1e-12, "GCI = {}", e.gci_fine);
+        assert_eq!(richardson(&limits([124.5, 122.5, 115.75], [0.5, 0.5, 0.25])), Some(Asymptotic::StepsGrow));
+        assert_eq!(richardson(&limits([123.5, 121.5, 118.15], [0.5, 0.5, 0.74])), Some(Asymptotic::StepsGrow));
+    }
+
     /// Steps that grow, change sign or lie within the brackets give no
     /// order; so do fewer than three rungs.
     #[test]
