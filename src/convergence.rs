@@ -204,8 +204,8 @@ mod tests {
     /// 12 / 24 / 48 rows. The steps −11 and −6 give `2ᵖ = 11/6`, so
     /// `p = log₂(11/6) = 0.874`, `φ_ext = 119.5 − 6 / (5/6) = 112.30` and
     /// `GCI = 1.25 × 7.2 / 119.5 = 7.53 %`. Case I's and Case II's
-    /// scanned ladders (124.50 / 122.50 / 115.75 and 123.50 / 121.50 /
-    /// 118.15 ± 0.74) have steps that grow.
+    /// scanned ladders (124.50 / 122.50 / 115.75 ± 0.25 and 123.50 /
+    /// 121.50 / 118.75 ± 0.25) have steps that grow.
     #[test]
     fn the_scanned_ladders_by_hand() {
         let limits = |v: [Real; 3], h: [Real; 3]| -> Vec<Rung> {
@@ -218,7 +218,7 @@ mod tests {
         assert!((e.extrapolated - 112.3).abs() < 1e-9, "φ_ext = {}", e.extrapolated);
         assert!((e.gci_fine - 1.25 * 7.2 / 119.5).abs() < 1e-12, "GCI = {}", e.gci_fine);
         assert_eq!(richardson(&limits([124.5, 122.5, 115.75], [0.5, 0.5, 0.25])), Some(Asymptotic::StepsGrow));
-        assert_eq!(richardson(&limits([123.5, 121.5, 118.15], [0.5, 0.5, 0.74])), Some(Asymptotic::StepsGrow));
+        assert_eq!(richardson(&limits([123.5, 121.5, 118.75], [0.5, 0.5, 0.25])), Some(Asymptotic::StepsGrow));
     }
 
     /// Steps that grow, change sign or lie within the brackets give no
