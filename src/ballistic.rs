@@ -1159,13 +1159,14 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
     let perforated_at = |st: &Study, v: Real| residual_at(st, v).filter(|&x| x > 0.0);
     for r in rungs {
         let st = &r.study;
-        let limit = limit_of(st);
+        let reading = st.limit_reading();
+        let limit = reading.as_ref().and_then(Limit::estimate);
         let wall: Real = st.shots.iter().map(|s| s.wall).sum();
         md.push_str(&format!(
             "| {} | {:.3} | {} | {} |",
             r.rows,
             r.spacing * 1e3,
-            st.limit_reading().map_or("—".into(), |l| l.cell()),
+            reading.as_ref().map_or("—".into(), Limit::cell),
             st.fit.map_or("—".into(), |f| format!(
                 "{:.3}, {:.2}, {:.2}{}",
                 f.a,
