@@ -10,7 +10,7 @@ use plugsim::bulk_viscosity::BulkViscosity;
 use plugsim::case::Case;
 use plugsim::contact::{SlaveSet, SurfaceDetection};
 use plugsim::fracture::growth::nodal_mass;
-use plugsim::fracture::{CrackGrowth, Criterion, EventKind, FractureParameters};
+use plugsim::fracture::{CrackGrowth, Criterion, EventKind, FractureParameters, TipDirection};
 use plugsim::geometry::GeometryMode;
 use plugsim::material::{Elastic, Material};
 use plugsim::math::{Block2, Real, Vec2};
@@ -353,6 +353,51 @@ fn one_crack_nucleates_per_failed_zone() {
     assert!(two.iter().any(|&x| x < 13.0) && two.iter().any(|&x| x > 25.0), "{two:?}");
 }
 
+/// `tip_direction = "max_shear"`: in a plate failed everywhere (every
+/// candidate meets the criterion, so only the direction rule decides),
+/// under pure shear stress `τ_xy` the current slip lines are x and y; the
+/// crack from the top face follows the one nearer its inward normal,
+/// pulled back to the reference configuration. Undeformed, that is
+/// straight down; after a simple shear `x += γ y` with γ = 1/2, the
+/// material line now vertical is `(−γ, 1)` in the reference lattice: the
+/// crack runs along the lattice direction `(1, −2)` (exactly its pull-back,
+/// `geometry::max_shear_direction`, tested against closed forms there).
+#[test]
+fn crack_follows_the_slip_line_pulled_back() {
+    let (nx, ny) = (21, 21);
+    let xc = 10.0 * H;
+    let top = (ny - 1) as Real * H;
+    let path = |gamma: Real| {
+        let mut m = plate(nx, ny);
+        // failed everywhere, highest at the top centre: one core there
+        set_field(&mut m, |x| 0.5 + 1e-3 * (x.y / H) - 1e-3 * ((x.x - xc).abs() / H));
+        for q in 0..m.quad.len() {
+            m.quad.tau[q] = Block2 { xx: 0.0, xy: 1e8, yx: 1e8, yy: 0.0, zz: 0.0 };
+            m.quad.f[q] = Block2 { xx: 1.0, xy: gamma, yx: 0.0, yy: 1.0, zz: 1.0 };
+        }
+        let mut g = CrackGrowth::new(FractureParameters {
+            tip_direction: TipDirection::MaxShear,
+            ..params(Criterion::EffectiveStrain)
+        });
+        drive(&mut m, &mut g, 6);
+        assert_eq!(g.cracks.len(), 1, "one crack");
+        g.cracks[0].vertices.iter().map(|v| v.x0).collect::<Vec<_>>()
+    };
+    for (gamma, step) in [(0.0, Vec2::new(0.0, -1.0)), (0.5, Vec2::new(1.0, -2.0))] {
+        let vertices = path(gamma);
+        assert!(vertices.len() >= 5, "γ = {gamma}: {} vertices", vertices.len());
+        let start = vertices[0];
+        assert!((start - Vec2::new(xc, top)).norm() < 1e-9 * H, "γ = {gamma}: nucleated at {start:?}");
+        for (k, x) in vertices.iter().enumerate() {
+            // on the line, one lattice step `step` (or a multiple along it) per vertex
+            let r = (x - start) / H;
+            let off_line = (r.x * step.y - r.y * step.x).abs() / step.norm();
+            assert!(off_line < 1e-9, "γ = {gamma}: vertex {k} at {r:?} spacings off the line {step:?}");
+            assert!(r.dot(&step) >= 0.0, "γ = {gamma}: vertex {k} behind the start");
+        }
+    }
+}
+
 /// The triaxiality cut-off: a failed zone under hydrostatic compression
 /// (σ_m/σ_eq = −1) nucleates nothing; the same zone in shear (0) does.
 #[test]
@@ -376,7 +421,7 @@ fn no_crack_nucleates_in_compression() {
     assert_eq!(run(0.0), 1, "shear: a crack");
     // nor does a crack grow into compressed material: a crack down a failed
     // column stops where the column is compressed
-    let grow = |mean: Real| {
+    let grow = |mean: Real, gate: Real| {
         let mut m = plate(nx, ny);
         set_field(&mut m, |x| if (x.x - 10.0 * H).abs() < 0.6 * H { 0.6 } else { 0.1 });
         let shear = nalgebra::Matrix3::new(0.0, 1e8, 0.0, 1e8, 0.0, 0.0, 0.0, 0.0, 0.0);
@@ -385,16 +430,22 @@ fn no_crack_nucleates_in_compression() {
             let p = if below { mean } else { 0.0 };
             m.quad.tau[q] = Block2::block_part(&(shear + nalgebra::Matrix3::identity() * (p * 3f64.sqrt() * 1e8)));
         }
-        let mut g = CrackGrowth::new(params(Criterion::EffectiveStrain));
+        let mut g =
+            CrackGrowth::new(FractureParameters { tip_min_triaxiality: gate, ..params(Criterion::EffectiveStrain) });
         let start = [id(&m, 10, ny - 1), id(&m, 10, ny - 2)];
         g.insert_crack(&mut m, &start, false).unwrap();
         drive(&mut m, &mut g, 12);
         let tip = g.cracks[0].tip.map(|t| m.particles.x0[t].y / H);
         (g.cracks[0].arrested.is_some(), tip)
     };
-    assert!(grow(0.0).0, "shear all the way: through the strip");
-    let (arrested, tip) = grow(-1.0);
+    let gate = FractureParameters::default().tip_min_triaxiality;
+    assert_eq!(gate, -1.0 / 3.0);
+    assert!(grow(0.0, gate).0, "shear all the way: through the strip");
+    let (arrested, tip) = grow(-1.0, gate);
     assert!(!arrested && tip.is_some_and(|y| y > (ny - 1) as Real - 4.5), "stops above the compressed part: {tip:?}");
+    // the gate lifted (`tip_min_triaxiality` below the column's −1): through
+    assert!(grow(-1.0, -1.5).0, "gate at -1.5: through the compressed part");
+    assert!(!grow(-1.0, -0.5).0, "gate at -0.5: stops");
 }
 
 #[test]
@@ -667,6 +718,7 @@ fn fracture_section_is_validated() {
         "fracture.radius_factor=0.5".to_string(),
         "fracture.nonlocal_radius=0.0".to_string(),
         "fracture.crack_speed_fraction=1.5".to_string(),
+        "fracture.tip_min_triaxiality=0.5".to_string(),
     ];
     let err = Case::from_str_with(text, "f.toml", &sets).unwrap_err().to_string();
     let keys = [
@@ -676,6 +728,7 @@ fn fracture_section_is_validated() {
         "radius_factor",
         "nonlocal_radius",
         "crack_speed_fraction",
+        "tip_min_triaxiality",
     ];
     for key in keys {
         assert!(err.contains(&format!("fracture.{key}")), "{key} not reported: {err}");
@@ -685,6 +738,11 @@ fn fracture_section_is_validated() {
     let bad =
         Case::from_str_with(text, "f.toml", &["fracture.criterion=\"stress\"".to_string()]).unwrap_err().to_string();
     assert!(bad.contains("stress"), "{bad}");
+    let bad =
+        Case::from_str_with(text, "f.toml", &["fracture.tip_direction=\"north\"".to_string()]).unwrap_err().to_string();
+    assert!(bad.contains("north") && bad.contains("max_shear"), "{bad}");
+    let slip = Case::from_str_with(text, "f.toml", &["fracture.tip_direction=\"max_shear\"".to_string()]).unwrap();
+    assert_eq!(slip.fracture.tip_direction, TipDirection::MaxShear);
     // a band wider than the averaging length is refused; the non-local criterion parses
     let wide = ["fracture.criterion=\"nonlocal_damage\"".to_string(), "fracture.band_width=2e-3".to_string()];
     let err = Case::from_str_with(text, "f.toml", &wide).unwrap_err().to_string();

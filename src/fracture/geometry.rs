@@ -154,6 +154,47 @@ pub fn point_segment_distance(a: &Vec2, b: &Vec2, x: &Vec2) -> Real {
     (closest_point_on_segment(a, b, x) - x).norm()
 }
 
+/// The direction of the slip line through a point: of the two in-plane
+/// directions of maximum shear stress of `tau` (current configuration,
+/// its symmetric part; at ±45° to the in-plane principal axes, the
+/// characteristics of plane plastic flow), pulled back to the reference
+/// configuration by the in-plane deformation gradient `f` (a material line
+/// `dx = F dX`), the one nearer to `reference` (up to sign), as a unit
+/// vector along `reference`. `None` where the in-plane shear stress
+/// vanishes (every direction is one of maximum shear) or `f` is singular.
+/// The crack-tip direction `tip_direction = "max_shear"`
+/// (module doc of [`crate::fracture`]); in 3D the same reading gives the
+/// plane of maximum shear, which contains the intermediate principal axis.
+pub fn max_shear_direction(
+    tau: &nalgebra::Matrix2<Real>,
+    f: &nalgebra::Matrix2<Real>,
+    reference: &Vec2,
+) -> Option<Vec2> {
+    let (sxx, syy, sxy) = (tau[(0, 0)], tau[(1, 1)], 0.5 * (tau[(0, 1)] + tau[(1, 0)]));
+    let radius = (0.25 * (sxx - syy).powi(2) + sxy * sxy).sqrt();
+    let scale = sxx.abs().max(syy.abs()).max(sxy.abs());
+    if radius.is_nan() || radius <= 1e-9 * scale || reference.norm() == 0.0 {
+        return None;
+    }
+    let finv = f.try_inverse()?;
+    let principal = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    let quarter = 0.25 * std::f64::consts::PI;
+    let mut best: Option<(Real, Vec2)> = None;
+    for a in [principal + quarter, principal - quarter] {
+        let back = finv * Vec2::new(a.cos(), a.sin());
+        let n = back.norm();
+        if !(n > 0.0 && n.is_finite()) {
+            continue;
+        }
+        let unit = back / n;
+        let c = unit.dot(reference);
+        if best.is_none_or(|(bc, _)| c.abs() > bc.abs()) {
+            best = Some((c, if c < 0.0 { -unit } else { unit }));
+        }
+    }
+    best.map(|(_, d)| d)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -211,5 +252,54 @@ mod tests {
         assert!((s.0 - PI).abs() < 1e-12);
         assert!(sector_contains(s, &v(0.3, 1.0)));
         assert!(!sector_contains(s, &v(0.3, -1.0)));
+    }
+
+    #[test]
+    fn max_shear_direction_is_the_slip_line_pulled_back() {
+        use nalgebra::Matrix2;
+        let id = Matrix2::identity();
+        // pure shear stress: slip lines along x and y
+        let shear = Matrix2::new(0.0, 1.0, 1.0, 0.0);
+        let d = max_shear_direction(&shear, &id, &v(0.2, -1.0)).unwrap();
+        assert!((d - v(0.0, -1.0)).norm() < 1e-12, "{d}");
+        let d = max_shear_direction(&shear, &id, &v(1.0, 0.3)).unwrap();
+        assert!((d - v(1.0, 0.0)).norm() < 1e-12, "{d}");
+        // uniaxial tension along x: slip lines at ±45°
+        let tension = Matrix2::new(2.0, 0.0, 0.0, 0.0);
+        let d = max_shear_direction(&tension, &id, &v(1.0, 0.9)).unwrap();
+        assert!((d - v(1.0, 1.0) / 2f64.sqrt()).norm() < 1e-12, "{d}");
+        // hydrostatic stress has no slip line; nor has a singular F
+        assert!(max_shear_direction(&Matrix2::identity(), &id, &v(1.0, 0.0)).is_none());
+        assert!(max_shear_direction(&shear, &Matrix2::zeros(), &v(1.0, 0.0)).is_none());
+        // simple shear x += γ y: the current slip lines x and y are the
+        // material lines X (unstretched) and (−γ, 1) (the line now vertical)
+        let g = 0.8;
+        let f = Matrix2::new(1.0, g, 0.0, 1.0);
+        let d = max_shear_direction(&shear, &f, &v(1.0, 0.1)).unwrap();
+        assert!((d - v(1.0, 0.0)).norm() < 1e-12, "{d}");
+        let d = max_shear_direction(&shear, &f, &v(0.0, 1.0)).unwrap();
+        assert!((d - v(-g, 1.0) / (1.0 + g * g).sqrt()).norm() < 1e-12, "{d}");
+    }
+
+    #[test]
+    fn max_shear_direction_is_objective() {
+        // a rigid rotation Q after any deformation: τ → Q τ Qᵀ, F → Q F;
+        // the reference direction does not move
+        use nalgebra::Matrix2;
+        let tau = Matrix2::new(3.0, -1.2, -1.2, 0.5);
+        let f = Matrix2::new(1.1, 0.4, -0.2, 0.9);
+        let reference = v(0.3, -1.0);
+        let d0 = max_shear_direction(&tau, &f, &reference).unwrap();
+        for a in [0.3, 1.2, 2.9, -2.0] {
+            let q = Matrix2::new(Real::cos(a), -Real::sin(a), Real::sin(a), Real::cos(a));
+            let d = max_shear_direction(&(q * tau * q.transpose()), &(q * f), &reference).unwrap();
+            assert!((d - d0).norm() < 1e-12, "rotation {a}: {d} against {d0}");
+        }
+        // and it is a direction of maximum shear: τ_nt at its push-forward
+        // is the Mohr circle's radius
+        let n = (f * d0).normalize();
+        let t = left_normal(&n);
+        let radius = (0.25 * (tau[(0, 0)] - tau[(1, 1)]).powi(2) + tau[(0, 1)].powi(2)).sqrt();
+        assert!(((t.transpose() * tau * n)[0].abs() - radius).abs() < 1e-12);
     }
 }

@@ -4,12 +4,12 @@
 //! [`crate::fracture`] for the choices and deviations.
 
 use super::geometry::{
-    closest_point_on_segment, left_bisector, left_normal, point_segment_distance, sector_angles, sector_contains,
-    widest_empty_sector,
+    closest_point_on_segment, left_bisector, left_normal, max_shear_direction, point_segment_distance, sector_angles,
+    sector_contains, widest_empty_sector,
 };
 use super::nonlocal::NonlocalAverage;
 use super::visibility::{CrackSegments, CrackVisibility};
-use super::{tip_speed, Criterion, FractureError, FractureParameters};
+use super::{tip_speed, Criterion, FractureError, FractureParameters, TipDirection};
 use crate::geometry::GeometryMode;
 use crate::material::Constitutive;
 use crate::math::{Real, Tensor3, Vec2};
@@ -18,6 +18,7 @@ use crate::neighbors::CellGrid;
 use crate::particles::{FaceSide, ParticleFlags};
 use crate::shape::ShapeTable;
 use crate::shape::{rebuild_rows, Basis};
+use nalgebra::Matrix2;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::sync::OnceLock;
@@ -85,18 +86,32 @@ fn logged_event(
 /// The lumped projection of the quadrature values `value(q)` at particle
 /// `i`, `Σ_q N_i(X_q) w_q c_q / Σ_q N_i(X_q) w_q` (0 without points).
 fn lumped_projection(model: &Model, i: usize, value: impl Fn(usize) -> Real) -> Real {
-    let (mut acc, mut wsum) = (0.0, 0.0);
+    lumped(model, i, 0.0, value)
+}
+
+/// [`lumped_projection`] of a quantity of any kind `T` (a scalar, a
+/// tensor block), `zero` without points.
+fn lumped<T>(model: &Model, i: usize, zero: T, value: impl Fn(usize) -> T) -> T
+where
+    T: Copy + std::ops::Add<Output = T> + std::ops::Mul<Real, Output = T> + std::ops::Div<Real, Output = T>,
+{
+    let (mut acc, mut wsum) = (zero, 0.0);
     for j in model.gather.range(i) {
         let q = model.gather.point[j] as usize;
         let w = model.gather.value[j] * model.quad.weight[q];
-        acc += w * value(q);
+        acc = acc + value(q) * w;
         wsum += w;
     }
     if wsum != 0.0 {
         acc / wsum
     } else {
-        0.0
+        zero
     }
+}
+
+/// The in-plane block of a [`crate::math::Block2`] as a matrix.
+fn in_plane_matrix(b: &crate::math::Block2) -> Matrix2<Real> {
+    Matrix2::new(b.xx, b.xy, b.yx, b.yy)
 }
 
 /// A segment may not pass within this fraction of a particle's spacing of
@@ -451,6 +466,33 @@ impl CrackGrowth {
         lumped_projection(model, i, |q| model.quad.damage[q])
     }
 
+    /// The direction a tip at particle `i` heads for in the reference
+    /// configuration, given the crack's (or, at nucleation, the inward)
+    /// direction `reference`: with `tip_direction = "max_shear"` the slip
+    /// line through the particle ([`max_shear_direction`] of the lumped
+    /// Kirchhoff stress and deformation gradient), `None` otherwise or
+    /// where the stress has no slip line (module doc of
+    /// [`crate::fracture`], "The tip's direction").
+    fn slip_line(&self, model: &Model, i: usize, reference: &Vec2) -> Option<Vec2> {
+        if self.params.tip_direction != TipDirection::MaxShear {
+            return None;
+        }
+        let q = &model.quad;
+        let tau = lumped(model, i, Matrix2::zeros(), |k| in_plane_matrix(&q.tau[k]));
+        let f = lumped(model, i, Matrix2::zeros(), |k| in_plane_matrix(&q.f[k]));
+        max_shear_direction(&tau, &f, reference)
+    }
+
+    /// How a candidate `j` at `r` from the tip ranks (larger first): its
+    /// [`Self::path_value`], or with a slip line its closeness in angle to
+    /// it.
+    fn rank(&self, model: &Model, j: usize, value: Real, r: &Vec2, slip: Option<&Vec2>) -> Real {
+        match slip {
+            Some(n) => -angle(r, n),
+            None => self.path_value(model, j, value),
+        }
+    }
+
     /// Smallest radius at which a crack may nucleate, m: in axisymmetry
     /// with `"nonlocal_damage"`, the averaging length `ℓ` — a ring crack
     /// nearer the axis is a core thinner than the ball its criterion
@@ -545,7 +587,8 @@ impl CrackGrowth {
                 continue;
             }
             let half_fan = 0.5 * self.params.fan_angle.to_radians();
-            // (path value, criterion value, particle)
+            let slip = self.slip_line(model, tip, &d);
+            // (rank, criterion value, particle)
             let mut best: Option<(Real, Real, usize)> = None;
             for &j in &circle {
                 if model.particles.flags[j].has(ParticleFlags::CRACK_FACE) {
@@ -556,11 +599,11 @@ impl CrackGrowth {
                     continue;
                 }
                 let value = self.criterion_value(model, j);
-                let rank = self.path_value(model, j, value);
+                let rank = self.rank(model, j, value, &r, slip.as_ref());
                 if value < critical || best.is_some_and(|(bv, _, _)| bv >= rank) {
                     continue;
                 }
-                if self.triaxiality(model, j) < NUCLEATION_MIN_TRIAXIALITY {
+                if self.triaxiality(model, j) < self.params.tip_min_triaxiality {
                     continue;
                 }
                 if self.passes_over(model, tip, j) || self.blocked_from_tip(model, c, j) {
@@ -750,7 +793,9 @@ impl CrackGrowth {
             if self.failed_zone_holds_a_crack(model, i, critical, &mut zones) {
                 continue;
             }
-            // (path value, criterion value, particle)
+            let inward = self.outward_normal(model, i).map(|n| -n);
+            let slip = inward.and_then(|n| self.slip_line(model, i, &n));
+            // (rank, criterion value, particle)
             let mut best: Option<(Real, Real, usize)> = None;
             for j in self.circle(model, i) {
                 let f = model.particles.flags[j];
@@ -758,7 +803,7 @@ impl CrackGrowth {
                     continue;
                 }
                 let value = self.criterion_value(model, j);
-                let rank = self.path_value(model, j, value);
+                let rank = self.rank(model, j, value, &(model.particles.x0[j] - xi), slip.as_ref());
                 if value < critical || best.is_some_and(|(bv, _, _)| bv >= rank) {
                     continue;
                 }
@@ -768,7 +813,6 @@ impl CrackGrowth {
                 if self.passes_over(model, i, j) || self.segments.blocked(&xi, &model.particles.x0[j]) {
                     continue;
                 }
-                let inward = self.outward_normal(model, i).map(|n| -n);
                 let oblique = MAX_SURFACE_OBLIQUITY.to_radians();
                 if inward.is_some_and(|n| angle(&(model.particles.x0[j] - xi), &n) > oblique) {
                     continue;
@@ -974,7 +1018,8 @@ impl CrackGrowth {
         let tip = self.cracks[c].tip?;
         let p = &model.particles;
         let xt = p.x0[tip];
-        if self.criterion_value(model, tip) < critical || self.triaxiality(model, tip) < NUCLEATION_MIN_TRIAXIALITY {
+        if self.criterion_value(model, tip) < critical || self.triaxiality(model, tip) < self.params.tip_min_triaxiality
+        {
             return None;
         }
         let half_fan = 0.5 * self.params.fan_angle.to_radians();
