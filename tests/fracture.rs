@@ -353,6 +353,54 @@ fn one_crack_nucleates_per_failed_zone() {
     assert!(two.iter().any(|&x| x < 13.0) && two.iter().any(|&x| x > 25.0), "{two:?}");
 }
 
+/// `nonlocal_tip_triaxiality`: the tip's compression gate reads the
+/// triaxiality averaged over `ℓ` (ratio of the averaged mean and von
+/// Mises stresses). In a uniform stress state the average is the state's
+/// own triaxiality, so the gate decides as the particle's would: at
+/// `σ_m/σ_eq = −1/2` a tip stops under the default −1/3 and runs through
+/// under −0.6. With the lower part of the strip compressed (−1) and the
+/// upper in shear (0), the tip stops within `ℓ` of the boundary, as the
+/// particle's gate stops it.
+#[test]
+fn the_tip_gate_over_a_length() {
+    let (nx, ny) = (21, 13);
+    let top = (ny - 1) as Real * H;
+    let run = |mean: Real, below_only: bool, gate: Real, nonlocal: bool| {
+        let mut m = plate(nx, ny);
+        set_field(&mut m, |x| if (x.x - 10.0 * H).abs() < 0.6 * H { 0.6 } else { 0.1 });
+        let shear = nalgebra::Matrix3::new(0.0, 1e8, 0.0, 1e8, 0.0, 0.0, 0.0, 0.0, 0.0);
+        for q in 0..m.quad.len() {
+            let p = if !below_only || m.quad.x0[q].y < top - 3.5 * H { mean } else { 0.0 };
+            m.quad.tau[q] = Block2::block_part(&(shear + nalgebra::Matrix3::identity() * (p * 3f64.sqrt() * 1e8)));
+        }
+        let mut g = CrackGrowth::new(FractureParameters {
+            tip_min_triaxiality: gate,
+            nonlocal_tip_triaxiality: nonlocal,
+            nonlocal_radius: 2.0 * H,
+            ..params(Criterion::EffectiveStrain)
+        });
+        let start = [id(&m, 10, ny - 1), id(&m, 10, ny - 2)];
+        g.insert_crack(&mut m, &start, false).unwrap();
+        drive(&mut m, &mut g, 16);
+        let tip = g.cracks[0].tip.map(|t| m.particles.x0[t].y / H);
+        (g.cracks[0].arrested.is_some(), tip)
+    };
+    let third = -1.0 / 3.0;
+    let start = Some((ny - 2) as Real);
+    assert_eq!(run(-0.5, false, third, true), (false, start), "uniform -1/2 under -1/3: no step");
+    assert!(run(-0.5, false, -0.6, true).0, "uniform -1/2 under -0.6: through");
+    let (arrested, own) = run(-1.0, true, third, false);
+    assert!(!arrested, "the particle's gate stops it");
+    let (arrested, averaged) = run(-1.0, true, third, true);
+    assert!(!arrested, "the averaged gate stops it too");
+    // the boundary lies at 8.5 spacings; the average reaches ℓ = 2 spacings
+    // across it, a candidate lies up to R = 2.5 spacings ahead
+    let (own, averaged) = (own.unwrap(), averaged.unwrap());
+    for tip in [own, averaged] {
+        assert!((8.5 - 2.0..=8.5 + 2.0 + 2.5).contains(&tip), "stopped at {tip} spacings");
+    }
+}
+
 /// `tip_direction = "max_shear"`: in a plate failed everywhere (every
 /// candidate meets the criterion, so only the direction rule decides),
 /// under pure shear stress `τ_xy` the current slip lines are x and y; the

@@ -453,6 +453,30 @@ impl CrackGrowth {
         av.average(&xi, &q.x0, area, &q.damage, |k| q.body[k] == body && !self.segments.blocked(&xi, &q.x0[k]))
     }
 
+    /// The triaxiality that gates a crack tip's step into particle `i`
+    /// (`tip_min_triaxiality`): the particle's own ([`Self::triaxiality`]),
+    /// or with `nonlocal_tip_triaxiality` the ratio of the mean and von
+    /// Mises stresses averaged over `ℓ` with the weights of
+    /// [`Self::nonlocal_damage`] (module doc of [`crate::fracture`], "The
+    /// compression gate on the tip").
+    fn tip_triaxiality(&self, model: &Model, i: usize) -> Real {
+        if !self.params.nonlocal_tip_triaxiality {
+            return self.triaxiality(model, i);
+        }
+        let q = &model.quad;
+        let av = self.nonlocal.get_or_init(|| NonlocalAverage::new(&q.x0, self.params.nonlocal_radius));
+        let (xi, body) = (model.particles.x0[i], model.particles.body[i]);
+        let area = |k: usize| q.weight[k] / model.mode.volume_factor(&q.x0[k]);
+        let include = |k: usize| q.body[k] == body && !self.segments.blocked(&xi, &q.x0[k]);
+        let (m, _) = av.sums(&xi, &q.x0, area, |k| q.tau[k].trace() / 3.0, include);
+        let (e, _) = av.sums(&xi, &q.x0, area, |k| q.tau[k].von_mises(), include);
+        if e > 0.0 {
+            m / e
+        } else {
+            0.0
+        }
+    }
+
     /// The value that ranks the candidates meeting the criterion, given
     /// particle `i`'s criterion value `value`: the value itself, except
     /// with `"nonlocal_damage"`, where it is the particle's own damage
@@ -603,7 +627,7 @@ impl CrackGrowth {
                 if value < critical || best.is_some_and(|(bv, _, _)| bv >= rank) {
                     continue;
                 }
-                if self.triaxiality(model, j) < self.params.tip_min_triaxiality {
+                if self.tip_triaxiality(model, j) < self.params.tip_min_triaxiality {
                     continue;
                 }
                 if self.passes_over(model, tip, j) || self.blocked_from_tip(model, c, j) {

@@ -110,13 +110,13 @@ impl NonlocalAverage {
     }
 
     /// `(Σ α A f, Σ α A)` over the points `q` within `ℓ` of `x` for which
-    /// `include(q)`, with areas `area(q)` and values `f[q]`.
+    /// `include(q)`, with areas `area(q)` and values `f(q)`.
     pub fn sums(
         &self,
         x: &Vec2,
         x0: &[Vec2],
         area: impl Fn(usize) -> Real,
-        f: &[Real],
+        f: impl Fn(usize) -> Real,
         include: impl Fn(usize) -> bool,
     ) -> (Real, Real) {
         let (mut acc, mut wsum) = (0.0, 0.0);
@@ -124,7 +124,7 @@ impl NonlocalAverage {
             let a = bell((x0[q] - x).norm(), self.radius);
             if a > 0.0 && include(q) {
                 let w = a * area(q);
-                acc += w * f[q];
+                acc += w * f(q);
                 wsum += w;
             }
         });
@@ -140,7 +140,7 @@ impl NonlocalAverage {
         f: &[Real],
         include: impl Fn(usize) -> bool,
     ) -> Real {
-        let (acc, wsum) = self.sums(x, x0, area, f, include);
+        let (acc, wsum) = self.sums(x, x0, area, |q| f[q], include);
         if wsum > 0.0 {
             acc / wsum
         } else {
@@ -176,7 +176,7 @@ mod tests {
             let av = NonlocalAverage::new(&pts, l);
             let x = Vec2::new(0.03e-3, -0.07e-3);
             let ones = vec![1.0; pts.len()];
-            let (_, w) = av.sums(&x, &pts, |_| h * h, &ones, |_| true);
+            let (_, w) = av.sums(&x, &pts, |_| h * h, |q| ones[q], |_| true);
             let err = (w / exact - 1.0).abs();
             assert!(err < 0.02 * (h / 0.1e-3).powi(2), "h = {h}: {w} vs {exact} ({err:.2e})");
         }
