@@ -354,7 +354,8 @@
 //!   of `D̄`, `CrackGrowth::tip_triaxiality`; in a uniform state it is the
 //!   state's own, `the_tip_gate_over_a_length`), the same plate holds to
 //!   126 m/s and perforates from 128 at 2 m/s steps (127.00 ± 1.00 m/s,
-//!   4.5 % above the default's first perforation), Case II's residual
+//!   4.5 % above the default's first perforation; Case I's plate
+//!   129.00 ± 1.00, the 12 mm plate 131.00 ± 1.00), Case II's residual
 //!   at 173.7 m/s reads 127.67 / 132.48 / 134.46 m/s and Case I's at 298
 //!   m/s 242.38 / 244.10 / 247.54 (12 / 24 / 48 rows). An option, not the
 //!   default: one plate at one resolution is not enough to change the
