@@ -453,8 +453,9 @@ impl CrackGrowth {
         av.average(&xi, &q.x0, area, &q.damage, |k| q.body[k] == body && !self.segments.blocked(&xi, &q.x0[k]))
     }
 
-    /// The triaxiality that gates a crack tip's step into particle `i`
-    /// (`tip_min_triaxiality`): the particle's own ([`Self::triaxiality`]),
+    /// The triaxiality that gates a crack tip's step into candidate `i`
+    /// (`tip_min_triaxiality`; a join, `Self::junction`, reads the tip's
+    /// own): the particle's own ([`Self::triaxiality`]),
     /// or with `nonlocal_tip_triaxiality` the ratio of the mean and von
     /// Mises stresses averaged over `ℓ` with the weights of
     /// [`Self::nonlocal_damage`] (module doc of [`crate::fracture`], "The

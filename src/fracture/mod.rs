@@ -510,11 +510,12 @@ pub struct FractureParameters {
     /// cut-off, the one nucleation keeps); −10 lifts it (module doc, "The
     /// compression gate").
     pub tip_min_triaxiality: Real,
-    /// Whether the tip's gate (`tip_min_triaxiality`) reads the
-    /// triaxiality averaged over `nonlocal_radius` (the ratio of the
-    /// averaged mean and von Mises stresses, the ball and weights of the
-    /// damage average) instead of the candidate particle's own. Default
-    /// false (module doc, "The compression gate on the tip").
+    /// Whether the tip's gate (`tip_min_triaxiality`) on its candidates
+    /// reads the triaxiality averaged over `nonlocal_radius` (the ratio of
+    /// the averaged mean and von Mises stresses, the ball and weights of
+    /// the damage average) instead of the candidate particle's own; the
+    /// join of a tip to another crack keeps the tip's own. Default false
+    /// (module doc, "The compression gate on the tip").
     pub nonlocal_tip_triaxiality: bool,
 }
 
