@@ -331,9 +331,9 @@
 //!   triaxiality is below the cut-off is passed over however damaged it
 //!   is, and a tip whose only way on is through compressed material waits.
 //!   Found on Case II's plate at 24 rows (`docs/validation.md`, "More than
-//!   one branch near the limit"): the tip reaches particle 556 (1.3 mm
-//!   under the impact face, 0.44 mm inside the rim) at 12 µs at every
-//!   speed from 116 to 136 m/s; the particle below it, 552, passes the
+//!   one branch near the limit"): at 133 and at 136 m/s the tip reaches
+//!   particle 556 (1.3 mm under the impact face, 0.44 mm inside the rim)
+//!   by 12 µs (as at 118–126 m/s); the particle below it, 552, passes the
 //!   average's threshold from about 16 µs on, but under the projectile's
 //!   rim its triaxiality stays at −0.43…−0.84, below −1/3. At 136 m/s it
 //!   rises past the cut-off at 20.6 µs and the crack runs through in 22 µs
