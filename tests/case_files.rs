@@ -82,6 +82,27 @@ fn unknown_material_rejected() {
     assert!(s.contains("bodies[0].material") && s.contains("unobtainium"), "{s}");
 }
 
+/// The damage locus's cut-off triaxiality: a built-in material carries it,
+/// a case file may give it, and a positive one is refused by its key.
+#[test]
+fn damage_cut_off_is_read_and_checked() {
+    let text = include_str!("../cases/borvik-1-axisymmetric-deformable.toml");
+    let line = "damage = { d1 = 100.0, d2 = 0.0, d3 = 0.0, d4 = 0.0, d5 = 0.0 }";
+    assert!(text.contains(line));
+    let cut = |v: &str| text.replace(line, &line.replace(" }", &format!(", cutoff_triaxiality = {v} }}")));
+    let case = Case::from_str_with(&cut("-0.3333"), "cut.toml", &[]).unwrap();
+    let Some(plugsim::material::Material::JohnsonCook(m)) = case.material("arne_tool_steel") else { panic!() };
+    assert_eq!(m.damage.cutoff_triaxiality, Some(-0.3333));
+    let s = match Case::from_str_with(&cut("0.2"), "bad.toml", &[]) {
+        Ok(_) => panic!("a positive cut-off must be refused"),
+        Err(e) => e.to_string(),
+    };
+    assert!(s.contains("materials.arne_tool_steel.damage.cutoff_triaxiality"), "{s}");
+    let plate = Case::from_str_with(text, "plate.toml", &["bodies.plate.material=weldox_460e_cutoff".into()]).unwrap();
+    let Some(plugsim::material::Material::JohnsonCook(w)) = plate.material(&plate.bodies[1].material) else { panic!() };
+    assert_eq!(w.damage.cutoff_triaxiality, Some(-1.0 / 3.0));
+}
+
 #[test]
 fn all_problems_reported_at_once() {
     let t = with("density = 7850.0", "density = -1.0").replace("end = 30.0e-6", "end = -1.0");

@@ -5,7 +5,7 @@
 
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use plugsim::material::johnson_cook::{JohnsonCook, RateForm};
-use plugsim::material::library::{weldox_460e, weldox_460e_borvik};
+use plugsim::material::library::{weldox_460e, weldox_460e_borvik, weldox_460e_cutoff};
 use plugsim::material::{fractured, Constitutive, Elastic, Material, PointState, StepKinematics};
 use plugsim::material_point::{run, DriverConfig, LoadPath, Record};
 
@@ -319,6 +319,66 @@ fn damage_reaches_one_at_the_analytic_failure_strain() {
         let (a, b) = (&r[i - 1], &r[i]);
         let at_failure = a.eps_p + (1.0 - a.damage) / (b.damage - a.damage) * (b.eps_p - a.eps_p);
         assert!(rel(at_failure, eps_f) < 2e-3, "{:?}: {at_failure} vs {eps_f}", m.rate_form);
+    }
+}
+
+/// Simple shear at 10⁴ s⁻¹ to `γ = 0.5` of a point that starts under the
+/// pressure `p0` (shear is isochoric, so the pressure stays, less the
+/// small thermal-expansion term): the stress state under a projectile's
+/// face. Returns the state after every step.
+fn shear_under_pressure(m: &JohnsonCook, p0: f64) -> Vec<PointState> {
+    let (rate, dt, steps) = (1e4, 1e-8, 5000);
+    let mut l = M3::zeros();
+    l[(0, 1)] = rate;
+    let k = StepKinematics { d: (l + l.transpose()) * 0.5, w: (l - l.transpose()) * 0.5, dt };
+    let mut state = PointState { tau: M3::identity() * -p0, ..PointState::at_rest(m.room_temperature) };
+    (0..steps)
+        .map(|_| {
+            state = m.update(&state, &k);
+            state
+        })
+        .collect()
+}
+
+/// Deviation 14: with Bao & Wierzbicki's cut-off a point sheared under a
+/// pressure that keeps `σ* < −1/3` accrues no damage, where \[RL10\]'s locus
+/// books `∫ dε̄/ε_f(σ*)`; under tension (`σ* > 0`) the two materials give
+/// the same path to the bit. The flow is the same either way (no coupling).
+#[test]
+fn upsetting_accrues_no_damage_below_the_cut_off() {
+    let (paper, cut) = (weldox_460e(), weldox_460e_cutoff());
+    let p0 = 0.5e9;
+    let (a, b) = (shear_under_pressure(&paper, p0), shear_under_pressure(&cut, p0));
+    let triaxiality = |s: &PointState| s.tau.trace() / 3.0 / von_mises(&s.tau);
+    // Once plastic, the state stays below the cut-off.
+    let plastic = a.iter().position(|s| s.eps_p > 1e-3).unwrap();
+    let (lo, hi) = a[plastic..].iter().map(triaxiality).fold((f64::MAX, f64::MIN), |(l, h), t| (l.min(t), h.max(t)));
+    assert!(lo > -1.2 && hi < -0.5, "σ* in [{lo}, {hi}]");
+    // The paper's locus: damage by the independent sum over the steps of
+    // Δε̄ / ε_f(σ*) with ε_f written out here (rate term at each step's rate).
+    let dc = paper.damage;
+    let mut want = 0.0;
+    for w in a.windows(2) {
+        let s = &w[0];
+        let r = &w[1];
+        let rate_term = 1.0 + dc.d4 * r.eps_p_rate.max(1.0).ln();
+        let eps_f = (dc.d1 + dc.d2 * (dc.d3 * triaxiality(s)).exp()) * rate_term;
+        want += (r.eps_p - s.eps_p) / eps_f;
+    }
+    let got = a.last().unwrap().damage;
+    assert!(got > 0.05 && rel(got, want) < 0.02, "paper's damage {got} vs {want}");
+    // The cut-off: none, and the same flow.
+    assert!(b.iter().all(|s| s.damage == 0.0), "damage below the cut-off");
+    for (x, y) in a.iter().zip(&b) {
+        assert_eq!((x.tau, x.eps_p, x.temperature), (y.tau, y.eps_p, y.temperature));
+    }
+    // Under tension (σ* > 0 throughout; shear alone would not do: the
+    // heating's constrained expansion pressurises the point to σ* ≈ −1/3):
+    // the same bits, damage included.
+    let (a0, b0) = (shear_under_pressure(&paper, -0.5e9), shear_under_pressure(&cut, -0.5e9));
+    assert!(a0.iter().all(|s| triaxiality(s) > 0.0) && a0.last().unwrap().damage > 0.05);
+    for (x, y) in a0.iter().zip(&b0) {
+        assert_eq!((x.tau, x.eps_p, x.damage), (y.tau, y.eps_p, y.damage));
     }
 }
 

@@ -134,6 +134,21 @@
 //!     impact), far below any effect on `g`. Tests:
 //!     `negligible_creep_fast_path_agrees_with_the_full_update`,
 //!     `power_upper_bound_is_a_bound`.
+//! 14. **Cut-off triaxiality (optional, beyond \[RL10\]).** With
+//!     `damage.cutoff_triaxiality = σ*_c` no damage accrues where
+//!     `σ* < σ*_c`: `ε_f = ∞` there. Bao & Wierzbicki (Eng. Fract. Mech. 72
+//!     (2005) 1049–1069) found from upsetting tests that ductile metals do
+//!     not fracture below `σ* = −1/3` (uniaxial compression), whatever the
+//!     strain; the Johnson–Cook exponential, fitted on tension tests, keeps
+//!     a finite `ε_f` there (Weldox 460 E: 2.1 at −1/3, 2.7 at −0.8), so
+//!     the material under a projectile's face accrues damage that no test
+//!     supports. The built-in `weldox_460e_cutoff` is \[RL10\]'s Weldox with
+//!     `σ*_c = −1/3`; without the field (every other material) the locus is
+//!     \[RL10\]'s. A triaxiality of exactly `σ*_c` still accrues damage. The
+//!     cut-off is a property of the locus, so it carries to 3D unchanged
+//!     (`σ*` is the same invariant there). Tests:
+//!     `the_cut_off_stops_damage_below_it_only`,
+//!     `tests/material.rs::upsetting_accrues_no_damage_below_the_cut_off`.
 
 use super::{jaumann_update, Constitutive, PointState, StepKinematics, ThermalProperties};
 use crate::math::{ddot, deviator, identity, mean_stress, von_mises, von_mises_2d, Block2, Real, Tensor3};
@@ -204,6 +219,11 @@ pub struct DamageConstants {
     pub d4: Real,
     /// `D₅`, dimensionless (temperature term).
     pub d5: Real,
+    /// Cut-off triaxiality `σ*_c` (≤ 0): below it no damage accrues
+    /// (`ε_f = ∞`; Deviation 14). `None` (the default, and \[RL10\]'s
+    /// locus): the formula at every triaxiality.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cutoff_triaxiality: Option<Real>,
 }
 
 /// Johnson–Cook thermo-viscoplastic material with isotropic hypoelasticity
@@ -362,8 +382,12 @@ impl JohnsonCook {
         check("thermal_expansion", self.thermal_expansion, true, "finite");
         check("conductivity", self.conductivity, self.conductivity >= 0.0, ">= 0");
         let dc = &self.damage;
-        for (name, v) in [("d1", dc.d1), ("d2", dc.d2), ("d3", dc.d3), ("d4", dc.d4), ("d5", dc.d5)] {
+        let constants = [("damage.d1", dc.d1), ("damage.d2", dc.d2), ("damage.d3", dc.d3), ("damage.d4", dc.d4)];
+        for (name, v) in constants.into_iter().chain([("damage.d5", dc.d5)]) {
             check(name, v, true, "finite");
+        }
+        if let Some(c) = dc.cutoff_triaxiality {
+            check("damage.cutoff_triaxiality", c, c <= 0.0, "<= 0 (no damage below it)");
         }
         check("theta", self.theta, (0.0..=1.0).contains(&self.theta), "in [0, 1]");
         if errors.is_empty() {
@@ -555,9 +579,13 @@ impl JohnsonCook {
     /// `ε_f = [D₁ + D₂ exp(D₃ σ*)] R(ε̇*) [1 + D₅ T*]` with `ε̇* = ε̄̇/ε̇₀` and
     /// `R = 1 + D₄ ln max(ε̇*, 1)` (log law) or `R = (1 + ε̇*)^{D₄}` (power
     /// law, Børvik). `T*` clamped to [0, 1] (Deviation 3), result floored at
-    /// [`MIN_FAILURE_STRAIN`] (Deviation 9).
+    /// [`MIN_FAILURE_STRAIN`] (Deviation 9). Below the cut-off
+    /// triaxiality, where the locus has one, `ε_f = ∞` (Deviation 14).
     pub fn failure_strain(&self, triaxiality: Real, rate: Real, temperature: Real) -> Real {
         let dc = &self.damage;
+        if dc.cutoff_triaxiality.is_some_and(|c| triaxiality < c) {
+            return Real::INFINITY;
+        }
         let rate_star = rate / self.reference_strain_rate;
         let stress_term = dc.d1 + dc.d2 * (dc.d3 * triaxiality).exp();
         let rate_term = match self.rate_form {
@@ -1112,6 +1140,32 @@ mod tests {
     }
 
     #[test]
+    fn the_cut_off_stops_damage_below_it_only() {
+        let m = weldox_460e();
+        let c = crate::material::library::weldox_460e_cutoff();
+        assert_eq!(c.damage.cutoff_triaxiality, Some(-1.0 / 3.0));
+        // Below −1/3: no damage, whatever the rate and temperature.
+        for s in [-0.34, -1.0, -20.0] {
+            assert_eq!(c.failure_strain(s, 1e4, 600.0), Real::INFINITY);
+            assert!(m.failure_strain(s, 1e4, 600.0).is_finite());
+        }
+        // At and above it: the Johnson–Cook locus, to the bit.
+        for s in [-1.0 / 3.0, -0.2, 0.0, 1.0 / 3.0, 2.0] {
+            assert_eq!(c.failure_strain(s, 1e4, 600.0).to_bits(), m.failure_strain(s, 1e4, 600.0).to_bits());
+        }
+        // A plastic step in strong compression books no damage with the
+        // cut-off, and exactly what it books without it otherwise.
+        let g = m.flow_stress(0.1, 293.0, 0.0);
+        let compressed = uniaxial(-1.05 * g) - identity() * (2.0 * g);
+        let old = state(compressed, 0.1, 293.0);
+        let k = kin(diag(-1e4, 0.5e4, 0.5e4), Tensor3::zeros(), 1e-8);
+        let (with, without) = (c.update(&old, &k), m.update(&old, &k));
+        assert!(without.damage > 0.0 && with.damage == 0.0, "{} {}", without.damage, with.damage);
+        assert_eq!(with.tau, without.tau);
+        assert_eq!(with.eps_p, without.eps_p);
+    }
+
+    #[test]
     fn hardening_slope_is_finite_at_zero_plastic_strain() {
         let m = weldox_460e();
         assert!(m.hardening_exponent < 1.0);
@@ -1474,7 +1528,14 @@ mod tests {
         m.theta = 1.5;
         m.damage.d2 = Real::NAN;
         let names: Vec<&str> = m.validate().unwrap_err().iter().map(|e| e.parameter).collect();
-        assert_eq!(names, ["poisson_ratio", "melting_temperature", "d2", "theta"]);
+        assert_eq!(names, ["poisson_ratio", "melting_temperature", "damage.d2", "theta"]);
+        let mut c = weldox_460e();
+        for (cut, ok) in [(-1.0 / 3.0, true), (0.0, true), (0.1, false), (Real::NEG_INFINITY, false)] {
+            c.damage.cutoff_triaxiality = Some(cut);
+            let names: Vec<&str> = c.validate().err().unwrap_or_default().iter().map(|e| e.parameter).collect();
+            assert_eq!(names.is_empty(), ok, "cut-off {cut}: {names:?}");
+            assert!(ok || names == ["damage.cutoff_triaxiality"]);
+        }
     }
 
     #[test]

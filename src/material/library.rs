@@ -11,13 +11,15 @@ use super::johnson_cook::{DamageConstants, JohnsonCook, RateForm};
 use super::Material;
 
 /// Names accepted by [`builtin`], in a stable order.
-pub const NAMES: &[&str] = &["weldox_460e", "weldox_460e_borvik", "ofhc_copper", "steel_4340", "steel_42crmo4"];
+pub const NAMES: &[&str] =
+    &["weldox_460e", "weldox_460e_borvik", "weldox_460e_cutoff", "ofhc_copper", "steel_4340", "steel_42crmo4"];
 
 /// The built-in material called `name`, or `None`.
 pub fn builtin(name: &str) -> Option<Material> {
     match name {
         "weldox_460e" => Some(Material::JohnsonCook(weldox_460e())),
         "weldox_460e_borvik" => Some(Material::JohnsonCook(weldox_460e_borvik())),
+        "weldox_460e_cutoff" => Some(Material::JohnsonCook(weldox_460e_cutoff())),
         "ofhc_copper" => Some(Material::JohnsonCook(ofhc_copper())),
         "steel_4340" => Some(Material::JohnsonCook(steel_4340())),
         "steel_42crmo4" => Some(Material::JohnsonCook(steel_42crmo4())),
@@ -52,7 +54,7 @@ pub fn weldox_460e() -> JohnsonCook {
         taylor_quinney: 0.9,
         thermal_expansion: 11.2e-6,
         conductivity: 50.0,
-        damage: DamageConstants { d1: 0.0705, d2: 1.732, d3: -0.54, d4: -0.015, d5: 0.0 },
+        damage: DamageConstants { d1: 0.0705, d2: 1.732, d3: -0.54, d4: -0.015, d5: 0.0, cutoff_triaxiality: None },
         damage_coupling: false,
         theta: JohnsonCook::DEFAULT_THETA,
     }
@@ -79,11 +81,26 @@ pub fn weldox_460e_borvik() -> JohnsonCook {
     }
 }
 
+/// Weldox 460 E as [`weldox_460e`], with the damage locus cut off below
+/// the triaxiality `−1/3` (no damage accrues in stronger compression).
+///
+/// Source of the cut-off: Y. Bao, T. Wierzbicki, "On the cut-off value of
+/// negative triaxiality for fracture", Eng. Fract. Mech. 72 (2005)
+/// 1049–1069 (upsetting tests: no fracture below `σ* = −1/3`). A material
+/// test, not a fit to any impact; every other constant is \[RL10\]'s. See
+/// Deviation 14 of [`super::johnson_cook`].
+pub fn weldox_460e_cutoff() -> JohnsonCook {
+    let mut m = weldox_460e();
+    m.damage.cutoff_triaxiality = Some(-1.0 / 3.0);
+    m
+}
+
 /// Damage constants of a metal whose Johnson–Cook failure constants the
 /// source does not give: `D₁ = 10³⁰`, the others 0, so the failure strain is
 /// 10³⁰ and the damage stays at 0 (it is only an output here: the Taylor
 /// cases grow no cracks). Not a fit of anything.
-pub const NO_DAMAGE: DamageConstants = DamageConstants { d1: 1.0e30, d2: 0.0, d3: 0.0, d4: 0.0, d5: 0.0 };
+pub const NO_DAMAGE: DamageConstants =
+    DamageConstants { d1: 1.0e30, d2: 0.0, d3: 0.0, d4: 0.0, d5: 0.0, cutoff_triaxiality: None };
 
 /// OFHC copper, Johnson & Cook's 1983 set (the material of their cylinder
 /// impact tests, the Taylor cases `taylor-cu-*`).
