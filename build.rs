@@ -18,4 +18,9 @@ fn main() {
     println!("cargo:rustc-env=PLUGSIM_COMMIT={commit}{}", if dirty { "-dirty" } else { "" });
     println!("cargo:rerun-if-changed=.git/HEAD");
     println!("cargo:rerun-if-changed=.git/index");
+    // An edit to the sources (not yet staged) must mark the binary dirty:
+    // without these, a build after editing kept the clean stamp of the
+    // last commit (`.git/index` changes only on `git add`).
+    println!("cargo:rerun-if-changed=src");
+    println!("cargo:rerun-if-changed=cases");
 }

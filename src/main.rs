@@ -147,6 +147,12 @@ enum Command {
         /// afresh).
         #[arg(long)]
         resume: bool,
+        /// Each run writes a snapshot (ParaView) at most this often, s, and always its last state;
+        /// the case's own output.interval where that is coarser; 0, or an explicit --set
+        /// output.interval=..., keeps the case's. A study of dozens of runs at the Borvik cases'
+        /// 1 us would fill a disk.
+        #[arg(long, default_value_t = plugsim::ballistic::SNAPSHOT_EVERY)]
+        snapshot_every: f64,
     },
     /// Benchmark fixed workloads: shape functions, material kernel, force
     /// assembly, whole steps (1 and all threads), optionally whole cases.
@@ -293,11 +299,24 @@ fn dispatch(cmd: Command) -> Result<()> {
             experiments,
             rows,
             resume,
+            snapshot_every,
         } => {
             let (case, name, file) = load(&case_file, &case, &set)?;
             let speeds = speeds.into_iter().flat_map(|s| s.0).collect();
-            let args =
-                BallisticArgs { speeds, limit, lo, hi, tol, max_time, projectile, jobs, experiments, rows, resume };
+            let args = BallisticArgs {
+                speeds,
+                limit,
+                lo,
+                hi,
+                tol,
+                max_time,
+                projectile,
+                jobs,
+                experiments,
+                rows,
+                resume,
+                snapshot_every,
+            };
             ballistic(case, &name, &file, &set, out, args)
         }
         Command::Bench { case, steps, whole, set } => bench(&case, steps, whole, &set),
@@ -587,6 +606,7 @@ struct BallisticArgs {
     experiments: Option<PathBuf>,
     rows: Vec<usize>,
     resume: bool,
+    snapshot_every: f64,
 }
 
 fn ballistic(
@@ -610,6 +630,13 @@ fn ballistic(
             );
         }
     }
+    if !(args.snapshot_every.is_finite() && args.snapshot_every >= 0.0) {
+        bail!("--snapshot-every must be a time >= 0 s (got {})", args.snapshot_every);
+    }
+    // An explicit `--set output.interval=...` is the user's choice: it wins.
+    let every =
+        if set.iter().any(|s| s.trim_start().starts_with("output.interval")) { 0.0 } else { args.snapshot_every };
+    let case = plugsim::ballistic::with_snapshots_every(case, every);
     // Every resolution is checked before the first run starts; the coarsest
     // runs first (its answer comes soonest), each once.
     let mut rows = args.rows.clone();
@@ -717,10 +744,12 @@ fn one_study(
         plugsim::ballistic::Projectile::Rigid(_) => "",
         plugsim::ballistic::Projectile::Deformable(_) => ", deformable: v_r its mass-averaged velocity",
     };
+    let snapshots = setup.case.resolved().output.interval.unwrap_or(0.0);
     let header = format!(
-        "Case {file}{}; projectile `{body}` (case impact speed {impact:.1} m/s{kind}); {jobs} runs side by side, {threads_per_run} thread(s) each; \
-         produced by `plugsim ballistic` ({} {}) on {}.",
+        "Case {file}{}; projectile `{body}` (case impact speed {impact:.1} m/s{kind}); {jobs} runs side by side, {threads_per_run} thread(s) each, \
+         a snapshot every {:.3} us; produced by `plugsim ballistic` ({} {}) on {}.",
         if set.is_empty() { String::new() } else { format!(" with {}", set.join(" ")) },
+        snapshots * 1e6,
         env!("CARGO_PKG_VERSION"),
         env!("PLUGSIM_COMMIT"),
         cpu_name()

@@ -415,3 +415,66 @@ fn a_resumed_study_continues_the_interrupted_runs_and_takes_back_the_finished() 
     std::fs::remove_dir_all(&s.out_dir).ok();
     std::fs::remove_dir_all(&whole.out_dir).ok();
 }
+
+/// `--snapshot-every`: a study's runs write a snapshot at most that often
+/// (the case's own interval where coarser, and always the last state); 0,
+/// or an explicit `--set output.interval`, keeps the case's.
+#[test]
+fn a_study_writes_sparse_snapshots_unless_told() {
+    let dir = std::env::temp_dir().join(format!("plugsim-ballistic-snapshots-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let case = dir.join("small.toml");
+    // The case asks for a snapshot every µs; its run lasts about 8 µs.
+    let text = small_plate();
+    assert!(text.contains("interval = 1.0e-5"));
+    std::fs::write(&case, text.replace("interval = 1.0e-5", "interval = 1.0e-6")).unwrap();
+    // The snapshot times of the run at 500 m/s in `out`, µs.
+    let times = |name: &str, args: &[&str]| -> Vec<f64> {
+        let out = dir.join(name);
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_plugsim"))
+            .args(["--threads", "1", "ballistic", case.to_str().unwrap(), "--speeds", "500"])
+            .args(["--out", out.to_str().unwrap()])
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let md = std::fs::read_to_string(out.join("ballistic.md")).unwrap();
+        let pvd = std::fs::read_to_string(out.join("v500.00/results.pvd")).unwrap();
+        let t: Vec<f64> = pvd
+            .lines()
+            .filter(|l| l.contains("part=\"0\""))
+            .map(|l| l.split("timestep=\"").nth(1).unwrap().split('"').next().unwrap().parse::<f64>().unwrap() * 1e6)
+            .collect();
+        let every = md.split("a snapshot every ").nth(1).unwrap().split(' ').next().unwrap().parse::<f64>().unwrap();
+        // Every snapshot but the last on the stated interval, none skipped.
+        for (i, ti) in t[..t.len() - 1].iter().enumerate() {
+            assert!((ti - i as f64 * every).abs() < 0.1 * every.min(1.0), "{name}: {t:?} every {every}");
+        }
+        assert!(t.last().unwrap() - t[t.len() - 2] <= every + 1e-3, "{name}: {t:?}");
+        t
+    };
+    let default = times("default", &[]);
+    let sparse = times("sparse", &["--snapshot-every", "3e-6"]);
+    let own = times("own", &["--snapshot-every", "0"]);
+    let told = times("told", &["--set", "output.interval=2e-6"]);
+    // The default's 10 µs: the first and the last state; 3 µs: 0, 3, 6
+    // and the last; the case's 1 µs (told 2 µs) where it is kept.
+    assert!(*default.last().unwrap() > 6.0, "the run lasts {default:?}");
+    assert_eq!(default.len(), 2, "{default:?}");
+    assert_eq!(sparse.len(), 4, "{sparse:?}");
+    assert!(own.len() >= 7 && sparse.len() < told.len() && told.len() < own.len(), "{own:?} {told:?}");
+    for t in [&sparse, &own, &told] {
+        assert_eq!(t.last(), default.last(), "the last state is written whatever the interval");
+    }
+    // A negative interval is refused, naming the option, before any run.
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_plugsim"))
+        .args(["ballistic", case.to_str().unwrap(), "--speeds", "500", "--snapshot-every=-1"])
+        .args(["--out", dir.join("bad").to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && stderr.contains("--snapshot-every"), "{stderr}");
+    assert!(!dir.join("bad").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
