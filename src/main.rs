@@ -97,62 +97,14 @@ enum Command {
         /// A built-in case by name (see `plugsim cases`).
         #[arg(long, conflicts_with = "case_file")]
         case: Option<String>,
-        /// Impact speeds to run, m/s: comma-separated, each a speed or an inclusive range
-        /// LO:HI:STEP (e.g. --speeds 116:134:1,140,150).
-        #[arg(long, value_delimiter = ',', value_parser = speed_item)]
-        speeds: Vec<SpeedItem>,
-        /// Find the ballistic limit by bisection.
-        #[arg(long)]
-        limit: bool,
-        /// Lower end of the search, m/s (default: half the case's impact speed).
-        #[arg(long, requires = "limit")]
-        lo: Option<f64>,
-        /// Upper end of the search, m/s (default: the case's impact speed).
-        #[arg(long, requires = "limit")]
-        hi: Option<f64>,
-        /// Tolerance of the limit, +- m/s.
-        #[arg(long, default_value_t = 1.0, requires = "limit")]
-        tol: f64,
-        /// Let a run still undecided at the case's end time (the plate neither held the projectile
-        /// nor let it go) go on up to this simulated time, s (default: 3 times the case's end time;
-        /// the case's end time to stop there).
-        #[arg(long)]
-        max_time: Option<f64>,
-        /// The body to fire, rigid or deformable (default: the case's only moving one).
-        #[arg(long)]
-        projectile: Option<String>,
-        /// Runs side by side (default: one per core, one thread each).
-        #[arg(long)]
-        jobs: Option<usize>,
         /// Override a case value, e.g. --set time.end=2e-4 (repeatable).
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
         /// Output directory (default: runs/ballistic-<case name>).
         #[arg(long)]
         out: Option<PathBuf>,
-        /// Experimental points to plot: a CSV with header v_i,v_r (m/s).
-        #[arg(long)]
-        experiments: Option<PathBuf>,
-        /// Run the whole study at each of these resolutions: particle rows
-        /// through the first deformable body's thickness (comma-separated,
-        /// e.g. 12,24,48; every deformable body refined by the same factor),
-        /// each into rows-N/, and write convergence.md/.csv/.png with the
-        /// limit and the residuals side by side, their spread and the last
-        /// refinement's step (coarsest first, each resolution once).
-        #[arg(long, value_delimiter = ',')]
-        rows: Vec<usize>,
-        /// Continue a study in --out: a speed whose run finished there with the same case (its
-        /// case.resolved.toml) is taken back as it is, a run an interrupt stopped there continues
-        /// from its checkpoint; every other speed runs afresh (without --resume every speed runs
-        /// afresh).
-        #[arg(long)]
-        resume: bool,
-        /// Each run writes a snapshot (ParaView) at most this often, s, and always its last state;
-        /// the case's own output.interval where that is coarser; 0, or an explicit --set
-        /// output.interval=..., keeps the case's. A study of dozens of runs at the Borvik cases'
-        /// 1 us would fill a disk.
-        #[arg(long, default_value_t = plugsim::ballistic::SNAPSHOT_EVERY)]
-        snapshot_every: f64,
+        #[command(flatten)]
+        args: BallisticArgs,
     },
     /// Benchmark fixed workloads: shape functions, material kernel, force
     /// assembly, whole steps (1 and all threads), optionally whole cases.
@@ -283,40 +235,8 @@ fn list_cases() -> Result<()> {
 fn dispatch(cmd: Command) -> Result<()> {
     match cmd {
         Command::Cases => list_cases(),
-        Command::Ballistic {
-            case_file,
-            case,
-            speeds,
-            limit,
-            lo,
-            hi,
-            tol,
-            max_time,
-            projectile,
-            jobs,
-            set,
-            out,
-            experiments,
-            rows,
-            resume,
-            snapshot_every,
-        } => {
+        Command::Ballistic { case_file, case, set, out, args } => {
             let (case, name, file) = load(&case_file, &case, &set)?;
-            let speeds = speeds.into_iter().flat_map(|s| s.0).collect();
-            let args = BallisticArgs {
-                speeds,
-                limit,
-                lo,
-                hi,
-                tol,
-                max_time,
-                projectile,
-                jobs,
-                experiments,
-                rows,
-                resume,
-                snapshot_every,
-            };
             ballistic(case, &name, &file, &set, out, args)
         }
         Command::Bench { case, steps, whole, set } => bench(&case, steps, whole, &set),
@@ -593,20 +513,67 @@ fn speed_item(item: &str) -> Result<SpeedItem, String> {
     plugsim::ballistic::parse_speeds(item).map(SpeedItem)
 }
 
-/// `plugsim ballistic`'s options besides the case.
+/// `plugsim ballistic`'s options besides the case, the overrides and the
+/// output directory.
+#[derive(clap::Args)]
 struct BallisticArgs {
-    speeds: Vec<f64>,
+    /// Impact speeds to run, m/s: comma-separated, each a speed or an inclusive range
+    /// LO:HI:STEP (e.g. --speeds 116:134:1,140,150).
+    #[arg(long, value_delimiter = ',', value_parser = speed_item)]
+    speeds: Vec<SpeedItem>,
+    /// Find the ballistic limit by bisection.
+    #[arg(long)]
     limit: bool,
+    /// Lower end of the search, m/s (default: half the case's impact speed).
+    #[arg(long, requires = "limit")]
     lo: Option<f64>,
+    /// Upper end of the search, m/s (default: the case's impact speed).
+    #[arg(long, requires = "limit")]
     hi: Option<f64>,
+    /// Tolerance of the limit, +- m/s.
+    #[arg(long, default_value_t = 1.0, requires = "limit")]
     tol: f64,
+    /// Let a run still undecided at the case's end time (the plate neither held the projectile
+    /// nor let it go) go on up to this simulated time, s (default: 3 times the case's end time;
+    /// the case's end time to stop there).
+    #[arg(long)]
     max_time: Option<f64>,
+    /// The body to fire, rigid or deformable (default: the case's only moving one).
+    #[arg(long)]
     projectile: Option<String>,
+    /// Runs side by side (default: one per core, one thread each).
+    #[arg(long)]
     jobs: Option<usize>,
+    /// Experimental points to plot: a CSV with header v_i,v_r (m/s).
+    #[arg(long)]
     experiments: Option<PathBuf>,
+    /// Run the whole study at each of these resolutions: particle rows
+    /// through the first deformable body's thickness (comma-separated,
+    /// e.g. 12,24,48; every deformable body refined by the same factor),
+    /// each into rows-N/, and write convergence.md/.csv/.png with the
+    /// limit and the residuals side by side, their spread and the last
+    /// refinement's step (coarsest first, each resolution once).
+    #[arg(long, value_delimiter = ',')]
     rows: Vec<usize>,
+    /// Continue a study in --out: a speed whose run finished there with the same case (its
+    /// case.resolved.toml) is taken back as it is, a run an interrupt stopped there continues
+    /// from its checkpoint; every other speed runs afresh (without --resume every speed runs
+    /// afresh).
+    #[arg(long)]
     resume: bool,
+    /// Each run writes a snapshot (ParaView) at most this often, s, and always its last state;
+    /// the case's own output.interval where that is coarser; 0, or an explicit --set
+    /// output.interval=..., keeps the case's. A study of dozens of runs at the Borvik cases'
+    /// 1 us would fill a disk.
+    #[arg(long, default_value_t = plugsim::ballistic::SNAPSHOT_EVERY)]
     snapshot_every: f64,
+}
+
+impl BallisticArgs {
+    /// `--speeds`, the ranges spelt out, in the order given.
+    fn speeds(&self) -> Vec<f64> {
+        self.speeds.iter().flat_map(|s| s.0.iter().copied()).collect()
+    }
 }
 
 fn ballistic(
@@ -619,7 +586,8 @@ fn ballistic(
 ) -> Result<()> {
     use plugsim::ballistic::{at_rows, read_experiments, select_projectile, write_ladder_files, Rung};
     let projectile = select_projectile(&case, file, args.projectile.as_deref())?;
-    if args.speeds.is_empty() && !args.limit {
+    let speeds = args.speeds();
+    if speeds.is_empty() && !args.limit {
         bail!("give --speeds V1,V2,... and/or --limit");
     }
     if let Some(t) = args.max_time {
@@ -686,8 +654,8 @@ fn ballistic(
         }
     );
     let title = format!("{}: v_r against v_i at {} resolutions", case.title, rungs.len());
-    let files = write_ladder_files(&out_dir, &header, &title, &rungs, &args.speeds, &experiments)?;
-    println!("{}", plugsim::ballistic::ladder_table(&rungs, &args.speeds).0);
+    let files = write_ladder_files(&out_dir, &header, &title, &rungs, &speeds, &experiments)?;
+    println!("{}", plugsim::ballistic::ladder_table(&rungs, &speeds).0);
     for f in files {
         println!("written: {}", f.display());
     }
@@ -799,7 +767,7 @@ fn one_study(
         out_dir.display()
     );
     let mut study = Study::default();
-    run_speeds(&setup, &args.speeds, &mut study, &mut report, &mut progress)?;
+    run_speeds(&setup, &args.speeds(), &mut study, &mut report, &mut progress)?;
     if args.limit && !study.interrupted {
         let bounds = (args.lo.unwrap_or(0.5 * impact), args.hi.unwrap_or(impact));
         find_limit(&setup, bounds, args.tol, &mut study, &mut report, &mut progress)?;

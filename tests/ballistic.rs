@@ -19,12 +19,18 @@ fn small_plate() -> String {
         + "[output]\ninterval = 1.0e-5\n"
 }
 
+/// An empty directory of this process under the system's temporary one.
+fn fresh_dir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("plugsim-ballistic-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
 fn setup(name: &str, jobs: usize) -> Setup {
     let case = Case::from_str_with(&small_plate(), "small", &[]).unwrap();
     let projectile = select_projectile(&case, "small", None).unwrap();
-    let out_dir = std::env::temp_dir().join(format!("plugsim-ballistic-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&out_dir);
-    std::fs::create_dir_all(&out_dir).unwrap();
+    let out_dir = fresh_dir(name);
     Setup {
         case,
         label: "small".into(),
@@ -190,9 +196,7 @@ fn an_interrupt_keeps_the_finished_runs() {
 /// be made is refused before any run starts.
 #[test]
 fn the_command_runs_the_study_at_each_resolution() {
-    let dir = std::env::temp_dir().join(format!("plugsim-ballistic-rows-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = fresh_dir("rows");
     let case = dir.join("small.toml");
     std::fs::write(&case, small_plate()).unwrap();
     let plugsim = |args: &[&str]| {
@@ -301,9 +305,7 @@ fn a_deformable_projectile_is_selected_set_and_refined_with_its_target() {
 fn a_study_fires_a_deformable_projectile() {
     let case = Case::from_str_with(&small_plate_deformable_projectile(), "soft", &[]).unwrap();
     let projectile = select_projectile(&case, "soft", None).unwrap();
-    let out_dir = std::env::temp_dir().join(format!("plugsim-ballistic-deformable-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&out_dir);
-    std::fs::create_dir_all(&out_dir).unwrap();
+    let out_dir = fresh_dir("deformable");
     let s = Setup {
         case,
         label: "soft".into(),
@@ -421,9 +423,7 @@ fn a_resumed_study_continues_the_interrupted_runs_and_takes_back_the_finished() 
 /// or an explicit `--set output.interval`, keeps the case's.
 #[test]
 fn a_study_writes_sparse_snapshots_unless_told() {
-    let dir = std::env::temp_dir().join(format!("plugsim-ballistic-snapshots-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = fresh_dir("snapshots");
     let case = dir.join("small.toml");
     // The case asks for a snapshot every µs; its run lasts about 8 µs.
     let text = small_plate();
