@@ -12,7 +12,7 @@ use super::visibility::{CrackSegments, CrackVisibility};
 use super::{tip_speed, Criterion, FractureError, FractureParameters, TipDirection};
 use crate::geometry::GeometryMode;
 use crate::material::Constitutive;
-use crate::math::{Real, Tensor3, Vec2};
+use crate::math::{Block2, Real, Tensor3, Vec2};
 use crate::model::{Gather, Model};
 use crate::neighbors::CellGrid;
 use crate::particles::{FaceSide, ParticleFlags};
@@ -469,13 +469,8 @@ impl CrackGrowth {
         let (xi, body) = (model.particles.x0[i], model.particles.body[i]);
         let area = |k: usize| q.weight[k] / model.mode.volume_factor(&q.x0[k]);
         let include = |k: usize| q.body[k] == body && !self.segments.blocked(&xi, &q.x0[k]);
-        let (m, _) = av.sums(&xi, &q.x0, area, |k| q.tau[k].trace() / 3.0, include);
-        let (e, _) = av.sums(&xi, &q.x0, area, |k| q.tau[k].von_mises(), include);
-        if e > 0.0 {
-            m / e
-        } else {
-            0.0
-        }
+        let (sums, _) = av.sums(&xi, &q.x0, area, |k| mean_and_von_mises(&q.tau[k]), include);
+        triaxiality_of(sums)
     }
 
     /// The value that ranks the candidates meeting the criterion, given
@@ -537,19 +532,12 @@ impl CrackGrowth {
     /// lumped projections of the quadrature points' mean and von Mises
     /// stresses (the same weights as [`Self::criterion_value`]).
     pub fn triaxiality(&self, model: &Model, i: usize) -> Real {
-        let (mut m, mut e) = (0.0, 0.0);
+        let mut sums = Vec2::zeros();
         for j in model.gather.range(i) {
             let q = model.gather.point[j] as usize;
-            let w = model.gather.value[j] * model.quad.weight[q];
-            let tau = &model.quad.tau[q];
-            m += w * (tau.trace() / 3.0);
-            e += w * tau.von_mises();
+            sums += mean_and_von_mises(&model.quad.tau[q]) * (model.gather.value[j] * model.quad.weight[q]);
         }
-        if e > 0.0 {
-            m / e
-        } else {
-            0.0
-        }
+        triaxiality_of(sums)
     }
 
     /// How far along its locus the material was where the cracks grew:
@@ -1293,5 +1281,21 @@ impl crate::shape::Visibility for OwnBody<'_> {
     #[inline]
     fn visible(&self, x: &Vec2, particle: usize) -> bool {
         self.body_of[particle] == self.body && self.cracks.visible(x, particle)
+    }
+}
+
+/// A stress's mean and von Mises values `(τ_m, τ̄)`, the two sums a
+/// triaxiality is the ratio of.
+fn mean_and_von_mises(tau: &Block2) -> Vec2 {
+    Vec2::new(tau.trace() / 3.0, tau.von_mises())
+}
+
+/// Triaxiality `Σ w τ_m / Σ w τ̄` from the two weighted sums (0 where no
+/// point carries shear).
+fn triaxiality_of(sums: Vec2) -> Real {
+    if sums.y > 0.0 {
+        sums.x / sums.y
+    } else {
+        0.0
     }
 }

@@ -67,6 +67,7 @@
 
 use crate::math::{Real, Vec2};
 use crate::neighbors::CellGrid;
+use std::ops::{AddAssign, Mul};
 
 /// Crack at `D̄ ≥ 1`: the Johnson–Cook locus's own failure.
 pub const CRITICAL_DAMAGE: Real = 1.0;
@@ -110,21 +111,25 @@ impl NonlocalAverage {
     }
 
     /// `(Σ α A f, Σ α A)` over the points `q` within `ℓ` of `x` for which
-    /// `include(q)`, with areas `area(q)` and values `f(q)`.
-    pub fn sums(
+    /// `include(q)`, with areas `area(q)` and values `f(q)` (a number, or
+    /// several summed in one pass over the ball, e.g. a [`Vec2`]).
+    pub fn sums<T>(
         &self,
         x: &Vec2,
         x0: &[Vec2],
         area: impl Fn(usize) -> Real,
-        f: impl Fn(usize) -> Real,
+        f: impl Fn(usize) -> T,
         include: impl Fn(usize) -> bool,
-    ) -> (Real, Real) {
-        let (mut acc, mut wsum) = (0.0, 0.0);
+    ) -> (T, Real)
+    where
+        T: Default + AddAssign + Mul<Real, Output = T>,
+    {
+        let (mut acc, mut wsum) = (T::default(), 0.0);
         self.grid.for_each_candidate(x, self.radius, |q| {
             let a = bell((x0[q] - x).norm(), self.radius);
             if a > 0.0 && include(q) {
                 let w = a * area(q);
-                acc += w * f(q);
+                acc += f(q) * w;
                 wsum += w;
             }
         });

@@ -382,8 +382,14 @@ impl JohnsonCook {
         check("thermal_expansion", self.thermal_expansion, true, "finite");
         check("conductivity", self.conductivity, self.conductivity >= 0.0, ">= 0");
         let dc = &self.damage;
-        let constants = [("damage.d1", dc.d1), ("damage.d2", dc.d2), ("damage.d3", dc.d3), ("damage.d4", dc.d4)];
-        for (name, v) in constants.into_iter().chain([("damage.d5", dc.d5)]) {
+        let constants = [
+            ("damage.d1", dc.d1),
+            ("damage.d2", dc.d2),
+            ("damage.d3", dc.d3),
+            ("damage.d4", dc.d4),
+            ("damage.d5", dc.d5),
+        ];
+        for (name, v) in constants {
             check(name, v, true, "finite");
         }
         if let Some(c) = dc.cutoff_triaxiality {
