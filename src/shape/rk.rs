@@ -44,6 +44,31 @@ pub enum ShapeError {
 /// conditions would lose more than six digits.
 pub const MAX_MOMENT_CONDITION: Real = 1e10;
 
+/// Largest Lebesgue sum `Λ(X) = Σ_I |N_I(X)|` a rebuilt row may have
+/// before [`row_with_fallback`] tries the next, smaller basis.
+///
+/// `Λ` bounds how much an interpolated field can exceed its nodal values,
+/// `|Σ N_I u_I| ≤ Λ max |u_I|`, and so how much a row can stiffen the
+/// particles it couples: the frequency bound of [`crate::stability`] grows
+/// with it. Rows of the undisturbed lattice have `Λ` ≈ 1, rows at a crack
+/// face up to 2.8 (measured on Case I's 48-row plate at 70 µs, 23 000
+/// particles), and the constant basis has `Λ = 1` exactly. A bilinear row
+/// with exactly four visible particles is an interpolant, and a nearly
+/// degenerate quadrilateral of them gives wild values: on that plate one
+/// point behind two crack tips had `Λ` = 80 (`N` = −20, −20, +40.6), which
+/// cut the stable step 26-fold and left the run crawling at
+/// 4.6·10⁻¹⁰ s a step (issue #19). The bound sits well above the crack-face
+/// rows and well below that one, so it takes the smaller basis only where
+/// the row has lost its shape. Deviation from [RL10] (which keeps the
+/// bilinear basis wherever it is regular); test:
+/// `an_interpolating_row_falls_back_to_a_bounded_one`.
+pub const MAX_LEBESGUE_SUM: Real = 4.0;
+
+/// The Lebesgue sum `Σ_I |N_I|` of a row ([`MAX_LEBESGUE_SUM`]).
+pub fn lebesgue_sum(row: &Row) -> Real {
+    row.iter().map(|r| r.1.abs()).sum()
+}
+
 /// One row of a table: `(particle, N, ∇N)` entries.
 pub type Row = Vec<(u32, Real, Vec2)>;
 
@@ -199,8 +224,10 @@ fn bilinear_row(
 }
 
 /// The row at `x` (evaluation point number `point`, for the error) with the
-/// richest basis whose moment matrix is regular ([`Basis`]); an error only
-/// if no particle is visible at all.
+/// richest basis whose moment matrix is regular ([`Basis`]) and whose
+/// Lebesgue sum is at most [`MAX_LEBESGUE_SUM`] (the constant basis always
+/// qualifies: its values are positive and sum to one); an error only if
+/// no particle is visible at all.
 #[allow(clippy::too_many_arguments)]
 pub fn row_with_fallback(
     point: usize,
@@ -215,7 +242,9 @@ pub fn row_with_fallback(
     visible_covering(x, search, vis, cand);
     let mut row = Row::new();
     for basis in [Basis::Bilinear, Basis::Linear, Basis::Constant] {
-        if row_with_basis(x, cand, x0, support, volume, basis, &mut row).is_ok() {
+        if row_with_basis(x, cand, x0, support, volume, basis, &mut row).is_ok()
+            && (basis == Basis::Constant || lebesgue_sum(&row) <= MAX_LEBESGUE_SUM)
+        {
             return Ok((row, basis));
         }
     }
@@ -374,6 +403,48 @@ mod tests {
         let line: Vec<u32> = vec![0, 1, 2];
         for (basis, regular) in [(Basis::Bilinear, false), (Basis::Linear, false), (Basis::Constant, true)] {
             assert_eq!(row_with_basis(&pts[1], &line, &x0, &a, &v, basis, &mut row).is_ok(), regular, "{basis:?}");
+        }
+    }
+
+    /// Four visible particles make the bilinear row an interpolant; when
+    /// they nearly lose the quadrilateral (the fourth a twentieth of a
+    /// spacing off the line of two others) its regular moment matrix still
+    /// gives values of +5 and −4.5 between them: by hand, the cardinal
+    /// functions of `[1, X, Y, XY]` on (0, 0), (h, 0), (0, h), (h, ε) are
+    /// `N₁ = 1 − X/h − Y/h + XY/h²`, `N₂ = X/h − XY/(hε)`,
+    /// `N₃ = Y/h − XY/h²`, `N₄ = XY/(hε)`: at (h/2, h/2) with ε = h/20,
+    /// `¼, −4½, ¼, 5`, Λ = 10. The
+    /// fallback takes the linear basis there, which reproduces linear
+    /// fields with `Λ` within the bound and gradients of the spacing's
+    /// order. The rows of an uncracked lattice, inside and at a corner,
+    /// stay far below the bound, so the guard leaves them bilinear.
+    #[test]
+    fn an_interpolating_row_falls_back_to_a_bounded_one() {
+        let h = 1e-3;
+        let x0 = vec![Vec2::new(0.0, 0.0), Vec2::new(h, 0.0), Vec2::new(0.0, h), Vec2::new(h, 0.05 * h)];
+        let (a, v) = (vec![2.0 * h; 4], vec![h * h; 4]);
+        let x = Vec2::new(0.5 * h, 0.5 * h);
+        let (cand, mut row) = (vec![0, 1, 2, 3], Row::new());
+        row_with_basis(&x, &cand, &x0, &a, &v, Basis::Bilinear, &mut row).expect("regular");
+        let bilinear = lebesgue_sum(&row);
+        assert!((bilinear - 10.0).abs() < 1e-9, "the degenerate quadrilateral's Λ = {bilinear}, by hand 10");
+        assert!(bilinear > 2.0 * MAX_LEBESGUE_SUM);
+        let search = SupportSearch::new(&x0, &a);
+        let (fallback, basis) = row_with_fallback(0, &x, &search, &x0, &a, &v, &AllVisible, &mut Vec::new()).unwrap();
+        assert_eq!(basis, Basis::Linear);
+        assert!(lebesgue_sum(&fallback) <= MAX_LEBESGUE_SUM);
+        let s: Real = fallback.iter().map(|r| r.1).sum();
+        let sx: Vec2 = fallback.iter().map(|r| x0[r.0 as usize] * r.1).sum();
+        assert!((s - 1.0).abs() < 1e-12 && (sx - x).norm() < 1e-12 * h, "linear reproduction: {s}, {sx}");
+        let steepest = |r: &Row| r.iter().map(|e| e.2.norm()).fold(0.0, Real::max);
+        assert!(steepest(&fallback) * h < 3.0, "gradients of the spacing's order: {}", steepest(&fallback) * h);
+        assert!(steepest(&row) > 3.0 * steepest(&fallback));
+        let (x0, a, v) = lattice(8, h);
+        let search = SupportSearch::new(&x0, &a);
+        for x in [Vec2::new(3.3 * h, 2.7 * h), Vec2::new(0.1 * h, 0.2 * h)] {
+            let (row, basis) = row_with_fallback(0, &x, &search, &x0, &a, &v, &AllVisible, &mut Vec::new()).unwrap();
+            assert_eq!(basis, Basis::Bilinear);
+            assert!(lebesgue_sum(&row) < 0.5 * MAX_LEBESGUE_SUM, "lattice row Λ = {}", lebesgue_sum(&row));
         }
     }
 
