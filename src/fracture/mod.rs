@@ -140,15 +140,22 @@
 //!   for them to meet the criterion.
 //! - **Bounded rebuilt rows.** A row rebuilt next to a crack takes the
 //!   bilinear basis only if its Lebesgue sum `Σ_I |N_I|` is at most
-//!   [`crate::shape::rk::MAX_LEBESGUE_SUM`] = 4, else the linear and then
-//!   the constant basis ([RL10] keeps the bilinear one wherever its moment
-//!   matrix is regular). With four visible particles the bilinear row
-//!   interpolates them, and a nearly degenerate quadrilateral gives wild
-//!   values: Case I's plate at 48 rows (cut-off locus, 150 m/s) had one
-//!   point with `Λ` = 80 behind two crack tips, which cut the stable step
-//!   26-fold at 63 µs and left the run crawling. Crack-face rows measure up
-//!   to `Λ` = 2.8. Test: `an_interpolating_row_falls_back_to_a_bounded_one`
-//!   (the degenerate quadrilateral's Λ = 10 by hand).
+//!   [`crate::shape::rk::MAX_LEBESGUE_SUM`] = 4 and its gradient sum
+//!   `L Σ_I |∇N_I|` at most [`crate::shape::rk::MAX_GRADIENT_SUM`] = 16,
+//!   else the linear and then the constant basis under the same test
+//!   ([RL10] keeps the bilinear one wherever its moment matrix is
+//!   regular). With four visible particles the bilinear row interpolates
+//!   them, and a nearly degenerate quadrilateral gives wild values: Case
+//!   I's plate at 48 rows (cut-off locus, 150 m/s) had one point with
+//!   `Λ` = 80 behind two crack tips, which cut the stable step 26-fold at
+//!   63 µs and left the run crawling; bounded in its values alone, the
+//!   same point's linear row (its particles nearly on a line) still had
+//!   `G` = 119 and held the step 11-fold down. Lattice rows measure
+//!   `Λ` ≈ 1, `G` ≈ 4, crack-face rows up to `Λ` = 2.8, `G` = 12. Tests:
+//!   `an_interpolating_row_falls_back_to_a_bounded_one` (the degenerate
+//!   quadrilateral's Λ = 10 by hand),
+//!   `a_row_across_a_line_of_particles_falls_back_to_shepard` (the linear
+//!   row's `∂N/∂Y = 1/ε` exactly).
 //! - Mass floor: at the apex of an acute wedge between a crack and the free
 //!   surface (a crack arriving obliquely), the bilinear RK function of the
 //!   apex particle is mostly negative over its few visible quadrature

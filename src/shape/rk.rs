@@ -48,25 +48,52 @@ pub const MAX_MOMENT_CONDITION: Real = 1e10;
 /// before [`row_with_fallback`] tries the next, smaller basis.
 ///
 /// `Λ` bounds how much an interpolated field can exceed its nodal values,
-/// `|Σ N_I u_I| ≤ Λ max |u_I|`, and so how much a row can stiffen the
-/// particles it couples: the frequency bound of [`crate::stability`] grows
-/// with it. Rows of the undisturbed lattice have `Λ` ≈ 1, rows at a crack
-/// face up to 2.8 (measured on Case I's 48-row plate at 70 µs, 23 000
-/// particles), and the constant basis has `Λ = 1` exactly. A bilinear row
-/// with exactly four visible particles is an interpolant, and a nearly
-/// degenerate quadrilateral of them gives wild values: on that plate one
-/// point behind two crack tips had `Λ` = 80 (`N` = −20, −20, +40.6), which
-/// cut the stable step 26-fold and left the run crawling at
-/// 4.6·10⁻¹⁰ s a step (issue #19). The bound sits well above the crack-face
-/// rows and well below that one, so it takes the smaller basis only where
-/// the row has lost its shape. Deviation from [RL10] (which keeps the
-/// bilinear basis wherever it is regular); test:
+/// `|Σ N_I u_I| ≤ Λ max |u_I|`; it also bounds how far the row can move
+/// mass in the lumping. Rows of the undisturbed lattice have `Λ` ≈ 1,
+/// rows at a crack face up to 2.8 (measured on Case I's 48-row plate at
+/// 63–70 µs, 23 000 particles), and the constant basis has `Λ = 1`
+/// exactly. A bilinear row with exactly four visible particles is their
+/// interpolant, and a nearly degenerate quadrilateral of them gives wild
+/// values: on that plate one point behind two crack tips had `Λ` = 80
+/// (`N` = −20, −20, +40.6), which cut the stable step 26-fold and left the
+/// run crawling at 4.6·10⁻¹⁰ s a step (issue #19), and lumped ten times
+/// a particle's nodal mass onto it. Deviation from [RL10] (which keeps
+/// the bilinear basis wherever it is regular); test:
 /// `an_interpolating_row_falls_back_to_a_bounded_one`.
 pub const MAX_LEBESGUE_SUM: Real = 4.0;
 
-/// The Lebesgue sum `Σ_I |N_I|` of a row ([`MAX_LEBESGUE_SUM`]).
-pub fn lebesgue_sum(row: &Row) -> Real {
-    row.iter().map(|r| r.1.abs()).sum()
+/// Largest gradient sum `G(X) = L Σ_I |∇N_I(X)|` a rebuilt row may have
+/// (`L` the mean support of its particles) before [`row_with_fallback`]
+/// tries the next, smaller basis.
+///
+/// `G` bounds the strain a row reads from a displacement field of unit
+/// size per support, so the stiffness the row gives its particles: the
+/// frequency bound of [`crate::stability`] grows with it. On Case I's
+/// 48-row plate at 63.6 µs the median row has `G` = 4.2, 99.9 % are below
+/// 6.3 and the crack-face rows reach 12.3; one point, whose four visible
+/// particles lie nearly on a line, had `G` = 119 with the linear basis
+/// (`Λ` = 3.6, within its bound), and the next 33: they still held the
+/// stable step 11-fold below the spacing step. With four particles on a
+/// line and a fifth `ε` off it, the linear row's `∂N/∂Y` of the fifth is
+/// exactly `1/ε`. The bound lets every lattice and crack-face row keep its
+/// basis. Test: `a_row_across_a_line_of_particles_falls_back_to_shepard`.
+pub const MAX_GRADIENT_SUM: Real = 16.0;
+
+/// `(Λ, G)` of a row: its Lebesgue sum `Σ_I |N_I|` ([`MAX_LEBESGUE_SUM`])
+/// and its gradient sum `L Σ_I |∇N_I|` ([`MAX_GRADIENT_SUM`]), `L` the mean
+/// of its particles' supports `support`.
+pub fn row_sums(row: &Row, support: &[Real]) -> (Real, Real) {
+    if row.is_empty() {
+        return (0.0, 0.0);
+    }
+    let l = row.iter().map(|r| support[r.0 as usize]).sum::<Real>() / row.len() as Real;
+    (row.iter().map(|r| r.1.abs()).sum(), l * row.iter().map(|r| r.2.norm()).sum::<Real>())
+}
+
+/// Whether a row stays within both of its bounds ([`row_sums`]).
+fn is_bounded(row: &Row, support: &[Real]) -> bool {
+    let (lebesgue, gradient) = row_sums(row, support);
+    lebesgue <= MAX_LEBESGUE_SUM && gradient <= MAX_GRADIENT_SUM
 }
 
 /// One row of a table: `(particle, N, ∇N)` entries.
@@ -225,9 +252,10 @@ fn bilinear_row(
 
 /// The row at `x` (evaluation point number `point`, for the error) with the
 /// richest basis whose moment matrix is regular ([`Basis`]) and whose
-/// Lebesgue sum is at most [`MAX_LEBESGUE_SUM`] (the constant basis always
-/// qualifies: its values are positive and sum to one); an error only if
-/// no particle is visible at all.
+/// Lebesgue and gradient sums stay within [`MAX_LEBESGUE_SUM`] and
+/// [`MAX_GRADIENT_SUM`] (the constant basis always qualifies: its values
+/// are positive and sum to one); an error only if no particle is visible
+/// at all.
 #[allow(clippy::too_many_arguments)]
 pub fn row_with_fallback(
     point: usize,
@@ -243,7 +271,7 @@ pub fn row_with_fallback(
     let mut row = Row::new();
     for basis in [Basis::Bilinear, Basis::Linear, Basis::Constant] {
         if row_with_basis(x, cand, x0, support, volume, basis, &mut row).is_ok()
-            && (basis == Basis::Constant || lebesgue_sum(&row) <= MAX_LEBESGUE_SUM)
+            && (basis == Basis::Constant || is_bounded(&row, support))
         {
             return Ok((row, basis));
         }
@@ -426,13 +454,13 @@ mod tests {
         let x = Vec2::new(0.5 * h, 0.5 * h);
         let (cand, mut row) = (vec![0, 1, 2, 3], Row::new());
         row_with_basis(&x, &cand, &x0, &a, &v, Basis::Bilinear, &mut row).expect("regular");
-        let bilinear = lebesgue_sum(&row);
+        let bilinear = row_sums(&row, &a).0;
         assert!((bilinear - 10.0).abs() < 1e-9, "the degenerate quadrilateral's Λ = {bilinear}, by hand 10");
         assert!(bilinear > 2.0 * MAX_LEBESGUE_SUM);
         let search = SupportSearch::new(&x0, &a);
         let (fallback, basis) = row_with_fallback(0, &x, &search, &x0, &a, &v, &AllVisible, &mut Vec::new()).unwrap();
         assert_eq!(basis, Basis::Linear);
-        assert!(lebesgue_sum(&fallback) <= MAX_LEBESGUE_SUM);
+        assert!(is_bounded(&fallback, &a));
         let s: Real = fallback.iter().map(|r| r.1).sum();
         let sx: Vec2 = fallback.iter().map(|r| x0[r.0 as usize] * r.1).sum();
         assert!((s - 1.0).abs() < 1e-12 && (sx - x).norm() < 1e-12 * h, "linear reproduction: {s}, {sx}");
@@ -444,8 +472,42 @@ mod tests {
         for x in [Vec2::new(3.3 * h, 2.7 * h), Vec2::new(0.1 * h, 0.2 * h)] {
             let (row, basis) = row_with_fallback(0, &x, &search, &x0, &a, &v, &AllVisible, &mut Vec::new()).unwrap();
             assert_eq!(basis, Basis::Bilinear);
-            assert!(lebesgue_sum(&row) < 0.5 * MAX_LEBESGUE_SUM, "lattice row Λ = {}", lebesgue_sum(&row));
+            let (lebesgue, gradient) = row_sums(&row, &a);
+            assert!(
+                lebesgue < 0.5 * MAX_LEBESGUE_SUM && gradient < 0.5 * MAX_GRADIENT_SUM,
+                "lattice row: {lebesgue}, {gradient}"
+            );
         }
+    }
+
+    /// Four particles on a line and a fifth ε = h/20 off it: the bilinear
+    /// moment matrix is singular (its `Y` and `XY` columns are
+    /// proportional), and the linear row, which reproduces `Y`, must give
+    /// the fifth particle `N₅ = Y/ε` exactly, so `∂N₅/∂Y = 1/ε` = 20/h: a
+    /// gradient sum far past the bound with values inside theirs. The
+    /// fallback goes on to Shepard's functions: positive, summing to one,
+    /// gradients of the support's order.
+    #[test]
+    fn a_row_across_a_line_of_particles_falls_back_to_shepard() {
+        let (h, eps) = (1e-3, 0.05e-3);
+        let mut x0: Vec<Vec2> = (0..4).map(|i| Vec2::new(i as Real * h, 0.0)).collect();
+        x0.push(Vec2::new(1.5 * h, eps));
+        let (a, v) = (vec![2.0 * h; 5], vec![h * h; 5]);
+        let x = Vec2::new(1.4 * h, 0.3 * eps);
+        let (cand, mut row) = ((0..5).collect::<Vec<u32>>(), Row::new());
+        assert!(row_with_basis(&x, &cand, &x0, &a, &v, Basis::Bilinear, &mut row).is_err());
+        row_with_basis(&x, &cand, &x0, &a, &v, Basis::Linear, &mut row).expect("regular");
+        let fifth = row.iter().find(|r| r.0 == 4).expect("the fifth particle covers x");
+        assert!((fifth.1 - 0.3).abs() < 1e-9, "N5 = Y/eps = 0.3, got {}", fifth.1);
+        assert!((fifth.2.y * eps - 1.0).abs() < 1e-6, "dN5/dY = 1/eps, got {} eps", fifth.2.y * eps);
+        let (lebesgue, gradient) = row_sums(&row, &a);
+        assert!(lebesgue <= MAX_LEBESGUE_SUM && gradient > MAX_GRADIENT_SUM, "linear row: {lebesgue}, {gradient}");
+        let search = SupportSearch::new(&x0, &a);
+        let (shepard, basis) = row_with_fallback(0, &x, &search, &x0, &a, &v, &AllVisible, &mut Vec::new()).unwrap();
+        assert_eq!(basis, Basis::Constant);
+        let s: Real = shepard.iter().map(|r| r.1).sum();
+        assert!((s - 1.0).abs() < 1e-12 && shepard.iter().all(|r| r.1 >= 0.0));
+        assert!(row_sums(&shepard, &a).1 < MAX_GRADIENT_SUM, "Shepard's gradient sum {}", row_sums(&shepard, &a).1);
     }
 
     /// The gradients of every basis are the derivatives of the values: a
