@@ -143,7 +143,7 @@
 //!   [`crate::shape::rk::MAX_LEBESGUE_SUM`] = 4 and its gradient sum
 //!   `L Σ_I |∇N_I|` at most [`crate::shape::rk::MAX_GRADIENT_SUM`] = 16,
 //!   else the linear and then the constant basis under the same test
-//!   ([RL10] keeps the bilinear one wherever its moment matrix is
+//!   (\[RL10\] keeps the bilinear one wherever its moment matrix is
 //!   regular). With four visible particles the bilinear row interpolates
 //!   them, and a nearly degenerate quadrilateral gives wild values: Case
 //!   I's plate at 48 rows (cut-off locus, 150 m/s) had one point with
@@ -343,7 +343,13 @@
 //!   against 2.18 m/s at 129; 132.38 against 128.66 m/s at 173.7). So the
 //!   lattice-scale fork that decides the outcome near the limit is in
 //!   *when* a candidate qualifies, not in *which* of several is taken: the
-//!   next entry.
+//!   next entry. With the damage locus cut off at −1/3
+//!   (`weldox_460e_cutoff`) it does matter: there the plug's interior, in
+//!   tension, outdoes the band in damage, and the most damaged candidate
+//!   turned Case I's 48-row crack inward at 298 m/s (half the plug, v_r
+//!   232.49 m/s), where the slip line keeps it in the band (the whole
+//!   plug, 240.02 m/s; 12 / 24 / 48 rows within 0.6 %: `docs/validation.md`,
+//!   "The cut-off with the slip-line tip").
 //! - **The compression gate on the tip** (`tip_min_triaxiality`, default
 //!   −1/3, the nucleation cut-off below). A candidate whose own
 //!   triaxiality is below the cut-off is passed over however damaged it

@@ -57,7 +57,7 @@ pub const MAX_MOMENT_CONDITION: Real = 1e10;
 /// values: on that plate one point behind two crack tips had `Λ` = 80
 /// (`N` = −20, −20, +40.6), which cut the stable step 26-fold and left the
 /// run crawling at 4.6·10⁻¹⁰ s a step (issue #19), and lumped ten times
-/// a particle's nodal mass onto it. Deviation from [RL10] (which keeps
+/// a particle's nodal mass onto it. Deviation from \[RL10\] (which keeps
 /// the bilinear basis wherever it is regular); test:
 /// `an_interpolating_row_falls_back_to_a_bounded_one`.
 pub const MAX_LEBESGUE_SUM: Real = 4.0;
