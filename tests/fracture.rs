@@ -16,8 +16,9 @@ use plugsim::material::{Elastic, Material};
 use plugsim::math::{Block2, Real, Vec2};
 use plugsim::model::{BodySetup, Gather, Model};
 use plugsim::particles::ParticleFlags;
-use plugsim::shape::Basis;
+use plugsim::shape::rk::{row_sums, MAX_GRADIENT_SUM, MAX_LEBESGUE_SUM};
 use plugsim::shape::ShapeTable;
+use plugsim::shape::{Basis, Row};
 use plugsim::step::{Simulation, TimeStepRule};
 
 const H: Real = 0.5e-3;
@@ -86,7 +87,9 @@ fn snapshot(m: &Model) -> Invariants {
 }
 
 /// Mass and momentum unchanged, reproduction at every quadrature point,
-/// no (evaluation point, particle) pair of either table across a crack, and
+/// every row bounded in its values and gradients (Shepard rows aside:
+/// `plugsim::shape::rk::MAX_LEBESGUE_SUM`, `MAX_GRADIENT_SUM`), no
+/// (evaluation point, particle) pair of either table across a crack, and
 /// the force gather equal to the transpose of the table.
 fn check_invariants(m: &Model, growth: &CrackGrowth, before: &Invariants, what: &str) {
     let p = &m.particles;
@@ -116,6 +119,12 @@ fn check_invariants(m: &Model, growth: &CrackGrowth, before: &Invariants, what: 
         if growth.reduced_quadrature_rows.get(&q) == Some(&Basis::Constant) {
             continue; // no full neighbourhood: partition of unity only
         }
+        let row: Row = t.range(q).map(|k| (t.index[k], t.value[k], t.grad[k])).collect();
+        let (lebesgue, gradient) = row_sums(&row, &p.support);
+        assert!(
+            lebesgue <= MAX_LEBESGUE_SUM && gradient <= MAX_GRADIENT_SUM,
+            "{what}: row {q} unbounded: Lebesgue sum {lebesgue}, gradient sum {gradient}"
+        );
         assert!((sx - x).norm() < 1e-9 * H, "{what}: linear reproduction at qp {q}");
         assert!((gx - nalgebra::Matrix2::identity()).norm() < 1e-7, "{what}: gradient reproduction at qp {q}");
     }
