@@ -45,6 +45,11 @@
 //!   spacing step, set by crack-face children under the projectile's rim;
 //!   `docs/validation.md`). Tests: `the_step_follows_a_light_particle`,
 //!   `frequency_bound_tracks_the_exact_highest_frequency`.
+//!   The step follows a stiff row as faithfully as a light particle, so
+//!   a row rebuilt at a crack is kept bounded where it is built
+//!   ([`crate::shape::rk::MAX_LEBESGUE_SUM`],
+//!   [`crate::shape::rk::MAX_GRADIENT_SUM`]): one unbounded row had held a
+//!   48-row run at a twentieth of the spacing step.
 //! - A change of step keeps the central difference second order: the
 //!   velocity update spans the mean of the two steps,
 //!   `V^{n+½} = V^{n−½} + ½ (Δt_{n−½} + Δt_{n+½}) a^n`
