@@ -82,7 +82,7 @@ pub const MAX_GRADIENT_SUM: Real = 16.0;
 /// `(Λ, G)` of a row: its Lebesgue sum `Σ_I |N_I|` ([`MAX_LEBESGUE_SUM`])
 /// and its gradient sum `L Σ_I |∇N_I|` ([`MAX_GRADIENT_SUM`]), `L` the mean
 /// of its particles' supports `support`.
-pub fn row_sums(row: &Row, support: &[Real]) -> (Real, Real) {
+pub fn row_sums(row: &[(u32, Real, Vec2)], support: &[Real]) -> (Real, Real) {
     if row.is_empty() {
         return (0.0, 0.0);
     }
@@ -90,8 +90,9 @@ pub fn row_sums(row: &Row, support: &[Real]) -> (Real, Real) {
     (row.iter().map(|r| r.1.abs()).sum(), l * row.iter().map(|r| r.2.norm()).sum::<Real>())
 }
 
-/// Whether a row stays within both of its bounds ([`row_sums`]).
-fn is_bounded(row: &Row, support: &[Real]) -> bool {
+/// Whether a row stays within both of its bounds ([`row_sums`]): the one
+/// test [`row_with_fallback`] applies and the fracture tests check.
+pub fn is_bounded(row: &[(u32, Real, Vec2)], support: &[Real]) -> bool {
     let (lebesgue, gradient) = row_sums(row, support);
     lebesgue <= MAX_LEBESGUE_SUM && gradient <= MAX_GRADIENT_SUM
 }
