@@ -1002,7 +1002,8 @@ pub fn table(study: &Study) -> (String, String) {
 
 /// How the outcome is read (printed in the report).
 pub const DEFINITIONS: &str = "Residual velocity v_r: the projectile's speed along its flight direction (that \
-of its initial velocity) at the end of the run, once a plug has been cut out and the contact force along \
+of its initial velocity) at the end of the run, once a plug has been cut out (or the projectile's nose is \
+one target thickness past the target's far face) and the contact force along \
 that direction (`NAME_f_axial` in each run's `history.csv`) has stayed below 0.1 % of its peak for at least \
 1 us; a touch on the side wall of the hole pushes across the flight and does not count. Held: the \
 projectile's speed along its flight fell to 1 % of the impact speed or below (stopped or bounced back): \

@@ -109,6 +109,9 @@ pub struct OutputWriter {
     flights: Vec<Vec2>,
     /// Each flight's release, followed every step ([`crate::residual`]).
     release: Vec<crate::residual::ReleaseTracker>,
+    /// Where each flight is through its target ([`through_positions`]),
+    /// found at the first use (the reference configuration does not change).
+    through: Option<Vec<Option<Real>>>,
     /// Step of the last history row (a step gets at most one).
     last_row_step: Option<u64>,
     /// The last snapshot, while its files are written on a thread of their
@@ -146,6 +149,7 @@ impl OutputWriter {
             names: rigid_names,
             flights: rigid.iter().map(|r| r.1).collect(),
             release: vec![Default::default(); rigid.len()],
+            through: None,
             last_row_step: None,
             pending: None,
         })
@@ -214,6 +218,7 @@ impl OutputWriter {
             names: rigid_names,
             flights: rigid.iter().map(|r| r.1).collect(),
             release: replay_releases(&kept, rigid),
+            through: None,
             last_row_step,
             pending: None,
         };
@@ -412,10 +417,16 @@ impl OutputWriter {
         Some(crate::contact::deformable_sample(p, &sim.f_contact, body, sim.contact.as_ref()))
     }
 
+    /// Where each flight is through its target ([`through_positions`]).
+    pub fn through(&mut self, sim: &Simulation) -> &[Option<Real>] {
+        self.through.get_or_insert_with(|| through_positions(sim, &self.names, &self.flights))
+    }
+
     /// Whether every moving body's flight is over, by the definitions
     /// of [`crate::residual`] held for `wait` (s): stopped or moving back, or
     /// free of force along its flight with a plug cut out (both for `wait`:
-    /// the plug, thrown ahead, may still be caught again). Call
+    /// the plug, thrown ahead, may still be caught again) or through its
+    /// target (free for `wait`). Call
     /// at the steps the history records, so that it and the verdict read
     /// from the history sample the same states (`time.stop_after_release`,
     /// [`crate::run`]); false without a
@@ -423,6 +434,7 @@ impl OutputWriter {
     /// a deformable projectile).
     pub fn flights_over(&mut self, sim: &Simulation, wait: Real) -> bool {
         let cut = self.plug.first_cut;
+        self.through(sim);
         let mut moving = 0;
         let mut over = 0;
         for b in 0..self.names.len().min(self.release.len()) {
@@ -436,12 +448,15 @@ impl OutputWriter {
                 continue;
             };
             let dir = self.flight_direction(b);
+            let through = self.through.as_ref().and_then(|t| t.get(b).copied().flatten());
             let tracker = &mut self.release[b];
             tracker.observe(sim.time, s.contact_force.dot(&dir), s.velocity.dot(&dir), impact);
             let stopped = tracker.stopped_for(sim.time).is_some_and(|t| t >= wait);
-            // Free for `wait` since the later of the release and the cut.
-            let free =
-                cut.is_some_and(|c| sim.time - c >= wait) && tracker.free_for(sim.time).is_some_and(|t| t >= wait);
+            // Free for `wait` since the later of the release and the cut, or
+            // since the release once through the target.
+            let passed = through.is_some_and(|p| s.position.dot(&dir) >= p);
+            let free = (passed || cut.is_some_and(|c| sim.time - c >= wait))
+                && tracker.free_for(sim.time).is_some_and(|t| t >= wait);
             moving += 1;
             over += usize::from(stopped || free);
         }
@@ -535,6 +550,33 @@ pub fn crack_piece(model: &Model, cracks: &crate::fracture::CrackGrowth) -> VtuP
 /// outline), under which [`crate::plug`] looks for the plug.
 pub fn impact_line(sim: &Simulation) -> Option<Real> {
     projectile_extent(sim).map(|(lo, hi)| 0.5 * (lo + hi))
+}
+
+/// Where each flight (`names` with their initial velocities `flights`:
+/// the rigid bodies, then the deformable projectiles) has passed through
+/// its target ([`crate::residual::through_at`]): for a rigid body, from
+/// its outline's forward-most vertex and the extent along its flight of
+/// the bodies that are not flights, in the reference configuration. `None`
+/// for a deformable projectile (its nose is not fixed in a body frame), a
+/// body at rest or a run without a target.
+pub fn through_positions(sim: &Simulation, names: &[String], flights: &[Vec2]) -> Vec<Option<Real>> {
+    let p = &sim.model.particles;
+    let target: Vec<bool> = sim.model.bodies.iter().map(|b| !names.contains(&b.name)).collect();
+    let rigid = sim.contact.as_ref().map_or(&[][..], |c| &c.bodies[..]);
+    flights
+        .iter()
+        .enumerate()
+        .map(|(b, &v0)| {
+            let d = crate::residual::flight_direction(v0);
+            let body = rigid.get(b).filter(|_| d != Vec2::zeros())?;
+            let nose = body.outline().iter().map(|v| v.dot(&d)).fold(Real::NEG_INFINITY, Real::max);
+            let (near, far) = (0..p.len())
+                .filter(|&i| target.get(p.body[i] as usize).copied().unwrap_or(false))
+                .map(|i| p.x0[i].dot(&d))
+                .fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), s| (lo.min(s), hi.max(s)));
+            (near <= far).then(|| crate::residual::through_at(nose, (near, far)))
+        })
+        .collect()
 }
 
 /// File name of snapshot `k`.

@@ -17,15 +17,28 @@
 //!   force at the threshold decelerates it by under 2·10³ m/s², which changes
 //!   its speed by under 0.04 m/s (0.02 %) over the 20 µs a validation run
 //!   goes on after release.
-//! - **Perforated**: a plug has been cut out and the projectile is released
-//!   at the end of the run, moving forward; the residual velocity `v_r` is
-//!   its speed along its flight direction at the end of the run.
+//! - **Perforated**: a plug has been cut out, or the projectile has passed
+//!   through the target (below), and the projectile is released at the end
+//!   of the run, moving forward; the residual velocity `v_r` is its speed
+//!   along its flight direction at the end of the run.
+//! - **Passed through**: the projectile's nose (its outline's forward-most
+//!   point along the flight) lies beyond the target's far face by the
+//!   target's whole depth along the flight (the extent of the bodies that
+//!   are not projectiles, in the reference configuration; [`through_at`]).
+//!   The material ahead of the nose is then at least twice the target's
+//!   depth beyond where it started: whatever still ties it to the plate is
+//!   torn, even where the cracks do not close a plug around it (two crack
+//!   tips that stopped short of each other across a ligament of failed
+//!   points). Found on Case II's plate at 48 rows with an optional tip
+//!   rule: the projectile flew on at 124.9 m/s, free of force for 190 µs
+//!   and 17 mm past the back face, and counted as held at `--max-time`
+//!   because no plug had been cut out (`docs/validation.md`).
 //! - **Held**: the projectile's speed along its flight direction has fallen
 //!   to [`STOP_FRACTION`] of the impact speed or below (stopped, or bounced
 //!   back); `v_r = 0`. Once stopped, the plate can only push it back.
 //! - Otherwise the run ended too early to tell: the projectile is still
-//!   pushed along its flight (or flies free without a plug cut out, ahead of
-//!   a plate that will catch it again).
+//!   pushed along its flight (or flies free without a plug cut out and
+//!   not yet through, ahead of a plate that may catch it again).
 //!
 //! `time.stop_after_release` stops a run by the same definitions
 //! ([`ReleaseTracker`], fed every step), reading the verdict of the run is
@@ -46,6 +59,18 @@ pub const FORCE_FRACTION: Real = 1.0e-3;
 /// A projectile whose speed along its flight has fallen to this fraction of
 /// the impact speed (or below) is held by the plate.
 pub const STOP_FRACTION: Real = 0.01;
+
+/// The position along the flight, `x·d` of the body frame's origin (m),
+/// from which a projectile has passed through its target (module doc):
+/// its nose, `nose` ahead of the origin along the flight (the largest
+/// `v·d` of its outline's vertices `v` in the body frame), is then one
+/// target depth beyond the far face. `target` is the target's extent
+/// `(near, far)` along the flight (`min` and `max` of `X·d` over its
+/// particles' reference positions).
+pub fn through_at(nose: Real, target: (Real, Real)) -> Real {
+    let (near, far) = target;
+    far + (far - near) - nose
+}
 
 /// Unit vector along `velocity`, zero for a body at rest.
 pub fn flight_direction(velocity: Vec2) -> Vec2 {
@@ -111,7 +136,8 @@ pub enum Verdict {
     /// Stopped or bounced back (since `since`, s): `v_r = 0`.
     Held { since: Real },
     /// Undecided at the end of the run: `speed` along the flight (m/s), and
-    /// whether a plug was cut out and whether the axial force had vanished.
+    /// whether a plug was cut out (or the projectile had passed through the
+    /// target) and whether the axial force had vanished.
     Undecided { speed: Real, plug: bool, free: bool },
     /// The body never moved (no flight direction).
     NotMoving,
@@ -147,26 +173,37 @@ impl Verdict {
     }
 }
 
-/// The verdict from a run's samples of one body, in time order: `(t,
-/// axial force, speed along the flight)`, with its impact speed (m/s) and
-/// whether a plug had been cut out by the end (module doc).
-pub fn verdict(samples: impl IntoIterator<Item = (Real, Real, Real)>, impact_speed: Real, plug: bool) -> Verdict {
+/// One sample of a flight: time (s), axial force (N), speed along the
+/// flight (m/s) and position along it (m, `x·d` of the body frame).
+pub type FlightSample = (Real, Real, Real, Real);
+
+/// The verdict from a run's samples of one body, in time order, with its
+/// impact speed (m/s), whether a plug had been cut out by the end and the
+/// position along the flight past which it is through its target
+/// ([`through_at`]; `None` where that is not known) (module doc).
+pub fn verdict(
+    samples: impl IntoIterator<Item = FlightSample>,
+    impact_speed: Real,
+    plug: bool,
+    through: Option<Real>,
+) -> Verdict {
     if impact_speed <= 0.0 {
         return Verdict::NotMoving;
     }
     let mut tracker = ReleaseTracker::default();
     let mut last = None;
-    for (t, f, v) in samples {
+    for (t, f, v, s) in samples {
         tracker.observe(t, f, v, impact_speed);
-        last = Some((t, v));
+        last = Some((t, v, s));
     }
-    let Some((end, speed)) = last else {
+    let Some((end, speed, position)) = last else {
         return Verdict::Undecided { speed: impact_speed, plug, free: false };
     };
     if let Some(since) = tracker.stopped_since {
         return Verdict::Held { since };
     }
     let free = tracker.free_for(end).is_some_and(|f| f >= FREE_FLIGHT);
+    let plug = plug || through.is_some_and(|p| position >= p);
     match (plug, free) {
         (true, true) => Verdict::Perforated { residual: speed, since: tracker.last_loaded.unwrap_or(end) },
         _ => Verdict::Undecided { speed, plug, free },
@@ -174,20 +211,23 @@ pub fn verdict(samples: impl IntoIterator<Item = (Real, Real, Real)>, impact_spe
 }
 
 /// The verdict of rigid body `name` from a run's history, given its flight
-/// direction (unit, or zero), impact speed (m/s) and whether a plug was cut
-/// out.
+/// direction (unit, or zero), impact speed (m/s), whether a plug was cut
+/// out and where it is through its target ([`verdict`]).
 pub fn verdict_from_history(
     table: &crate::io::HistoryTable,
     name: &str,
     flight: Vec2,
     impact_speed: Real,
     plug: bool,
+    through: Option<Real>,
 ) -> Option<Verdict> {
     let t = table.column("time")?;
     let f = table.column(&format!("{name}_f_axial"))?;
     let (vx, vy) = (table.column(&format!("{name}_vx"))?, table.column(&format!("{name}_vy"))?);
-    let samples = (0..t.len()).map(|k| (t[k], f[k], vx[k] * flight.x + vy[k] * flight.y));
-    Some(verdict(samples, impact_speed, plug))
+    let (x, y) = (table.column(&format!("{name}_x"))?, table.column(&format!("{name}_y"))?);
+    let samples =
+        (0..t.len()).map(|k| (t[k], f[k], vx[k] * flight.x + vy[k] * flight.y, x[k] * flight.x + y[k] * flight.y));
+    Some(verdict(samples, impact_speed, plug, through))
 }
 
 #[cfg(test)]
@@ -196,16 +236,21 @@ mod tests {
 
     /// Rows every 0.4 µs: the plate brakes the projectile from 300 m/s for
     /// 10 µs, then `after` gives each later row's (axial force, speed).
-    fn rows(after: impl Fn(Real) -> (Real, Real)) -> Vec<(Real, Real, Real)> {
-        (0..100)
+    fn rows(after: impl Fn(Real) -> (Real, Real)) -> Vec<FlightSample> {
+        rows_for(100, after)
+    }
+
+    /// [`rows`], `n` of them; each row's position along the flight is the
+    /// integral of the speeds before it, from 0.
+    fn rows_for(n: usize, after: impl Fn(Real) -> (Real, Real)) -> Vec<FlightSample> {
+        let mut s = 0.0;
+        (0..n)
             .map(|k| {
                 let t = k as Real * 0.4e-6;
-                if t <= 10e-6 {
-                    (t, -1.0e7, 300.0 - 5.0e6 * t)
-                } else {
-                    let (f, v) = after(t);
-                    (t, f, v)
-                }
+                let (f, v) = if t <= 10e-6 { (-1.0e7, 300.0 - 5.0e6 * t) } else { after(t) };
+                let row = (t, f, v, s);
+                s += v * 0.4e-6;
+                row
             })
             .collect()
     }
@@ -214,42 +259,72 @@ mod tests {
     fn a_side_wall_touch_without_axial_force_is_a_release() {
         // After 10 µs only the hole's wall touches the side: the contact
         // counts exist, but the force along the flight is zero.
-        let v = verdict(rows(|_| (0.0, 250.0)), 300.0, true);
+        let v = verdict(rows(|_| (0.0, 250.0)), 300.0, true, None);
         assert!(
             matches!(v, Verdict::Perforated { residual, since } if residual == 250.0 && (since - 10e-6).abs() < 0.5e-6),
             "{v:?}"
         );
         assert_eq!(v.residual(), Some(250.0));
         // Noise below 0.1 % of the peak is no force either.
-        let v = verdict(rows(|_| (-5.0e3, 250.0)), 300.0, true);
+        let v = verdict(rows(|_| (-5.0e3, 250.0)), 300.0, true, None);
         assert!(matches!(v, Verdict::Perforated { residual, .. } if residual == 250.0), "{v:?}");
     }
 
     #[test]
     fn an_axial_force_at_the_end_is_no_release() {
         // The plug is pushed ahead to the end.
-        let v = verdict(rows(|_| (-1.0e5, 250.0)), 300.0, true);
+        let v = verdict(rows(|_| (-1.0e5, 250.0)), 300.0, true, None);
         assert_eq!(v, Verdict::Undecided { speed: 250.0, plug: true, free: false });
         assert_eq!(v.residual(), None);
         // A force that came back less than FREE_FLIGHT before the end.
-        let v = verdict(rows(|t| (if t > 39.0e-6 { -1.0e5 } else { 0.0 }, 250.0)), 300.0, true);
+        let v = verdict(rows(|t| (if t > 39.0e-6 { -1.0e5 } else { 0.0 }, 250.0)), 300.0, true, None);
         assert!(matches!(v, Verdict::Undecided { free: false, .. }), "{v:?}");
         // Released, but no plug cut out: the plate will catch it again.
-        let v = verdict(rows(|_| (0.0, 250.0)), 300.0, false);
+        let v = verdict(rows(|_| (0.0, 250.0)), 300.0, false, None);
         assert_eq!(v, Verdict::Undecided { speed: 250.0, plug: false, free: true });
+    }
+
+    /// A blunt projectile 80 mm long, its origin at its centre and its face
+    /// 0.05 mm above a plate 10 mm thick (y from 0 to 10 mm), flying down
+    /// (`d = −y`): along the flight the plate spans `(−10, 0)` mm, the
+    /// nose is 40 mm ahead of the origin, which starts at −50.05 mm. It is
+    /// through when its face is 10 mm below the back face: the origin at
+    /// 0 + 10 − 40 = −30 mm along the flight, 20.05 mm on.
+    #[test]
+    fn a_projectile_through_its_target_is_perforating_without_a_plug() {
+        let through = through_at(0.040, (-0.010, 0.0));
+        assert!((through - -0.030).abs() < 1e-15, "{through}");
+        // 100 µs of rows: braked from 300 to 250 m/s over 10 µs, then free
+        let flight = |end_speed: Real| {
+            let r = rows_for(250, move |_| (0.0, end_speed));
+            r.into_iter().map(|(t, f, v, s)| (t, f, v, s - 0.05005)).collect::<Vec<_>>()
+        };
+        let end = |r: &[FlightSample]| r.last().unwrap().3;
+        // 250 m/s: 2.9 mm while braked, then 22.3 mm: 5.1 mm past the mark
+        let fast = flight(250.0);
+        assert!(end(&fast) > through + 4e-3, "{} mm", end(&fast) * 1e3);
+        let v = verdict(fast.clone(), 300.0, false, Some(through));
+        assert!(matches!(v, Verdict::Perforated { residual, .. } if residual == 250.0), "{v:?}");
+        // without the mark (not known), or not yet through: undecided
+        assert!(matches!(verdict(fast, 300.0, false, None), Verdict::Undecided { plug: false, .. }));
+        let slow = flight(100.0);
+        // 100 m/s: 11.8 mm on, 8.3 mm short of the mark
+        assert!(end(&slow) < through - 5e-3, "{} mm", end(&slow) * 1e3);
+        let v = verdict(slow, 300.0, false, Some(through));
+        assert_eq!(v, Verdict::Undecided { speed: 100.0, plug: false, free: true });
     }
 
     #[test]
     fn a_stopped_or_rebounding_projectile_is_held() {
         // Bounces back and flies free backwards: v_r = 0, held.
-        let v = verdict(rows(|_| (0.0, -20.0)), 300.0, false);
+        let v = verdict(rows(|_| (0.0, -20.0)), 300.0, false, None);
         assert!(matches!(v, Verdict::Held { since } if since > 10e-6), "{v:?}");
         assert_eq!(v.residual(), Some(0.0));
         // Stopped in the plate, still pressed (held even with a plug cut).
-        let v = verdict(rows(|_| (-1.0e4, 1.0)), 300.0, true);
+        let v = verdict(rows(|_| (-1.0e4, 1.0)), 300.0, true, None);
         assert!(matches!(v, Verdict::Held { .. }), "{v:?}");
         // A body that never moved.
-        assert_eq!(verdict(rows(|_| (0.0, 0.0)), 0.0, false), Verdict::NotMoving);
+        assert_eq!(verdict(rows(|_| (0.0, 0.0)), 0.0, false, None), Verdict::NotMoving);
     }
 
     #[test]

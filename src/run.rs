@@ -525,13 +525,16 @@ fn time_loop(
     let history = crate::output::read_history(&cfg.out_dir)?;
     let last_contacts = crate::output::last_contact_times(&history, &names);
     let perforation = crate::output::perforation_time(&history);
+    let through = out.through(&sim).to_vec();
     let flights = case
         .flights()
         .into_iter()
-        .filter_map(|(name, v0)| {
+        .enumerate()
+        .filter_map(|(b, (name, v0))| {
             let dir = crate::residual::flight_direction(v0);
-            let verdict =
-                crate::residual::verdict_from_history(&history, &name, dir, v0.norm(), perforation.is_some())?;
+            let plug = perforation.is_some();
+            let through = through.get(b).copied().flatten();
+            let verdict = crate::residual::verdict_from_history(&history, &name, dir, v0.norm(), plug, through)?;
             Some((name, verdict))
         })
         .collect();

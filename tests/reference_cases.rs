@@ -249,3 +249,29 @@ fn nose_shape_cases_share_the_family_parameters_and_keep_reflections_out() {
     noses.dedup();
     assert_eq!(noses.len(), BORVIK_NOSE_CASES.len(), "one case per nose");
 }
+
+/// A projectile is through its target ([`plugsim::residual`]) once its
+/// nose lies one target depth beyond the target's far face: for Børvik's
+/// plates, hit from above, when the nose is one plate thickness below the
+/// back face (y = 0). From the case files: the blunt face starts 0.05 mm
+/// above the 10.2 mm plate, the hemispherical tip at y = 12.05 mm above
+/// the 12 mm plate; the body frame's origin must then have moved down by
+/// the face's travel, `face + thickness`.
+#[test]
+fn a_projectile_is_through_one_plate_thickness_past_the_back_face() {
+    for (name, thickness, nose) in [
+        ("borvik-2-axisymmetric-nonlocal", 0.0102, 0.0102 + 0.05e-3),
+        ("borvik-2002-12mm-hemispherical", 0.012, 0.01205),
+    ] {
+        let case = load(name);
+        let sim = plugsim::run::build_simulation(&case).unwrap();
+        let (names, v0): (Vec<String>, Vec<_>) = case.flights().into_iter().unzip();
+        let through = plugsim::output::through_positions(&sim, &names, &v0);
+        let origin = sim.contact.as_ref().unwrap().bodies[0].position;
+        // along the flight (−y): the origin's position when through
+        let expected = -(origin.y - (nose + thickness));
+        assert_eq!(through.len(), 1, "{name}");
+        let got = through[0].unwrap_or_else(|| panic!("{name}: no target"));
+        assert!((got - expected).abs() < 1e-9, "{name}: through at {got} m along the flight, expected {expected}");
+    }
+}
