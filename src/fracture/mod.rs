@@ -349,7 +349,14 @@
 //!   turned Case I's 48-row crack inward at 298 m/s (half the plug, v_r
 //!   232.49 m/s), where the slip line keeps it in the band (the whole
 //!   plug, 240.02 m/s; 12 / 24 / 48 rows within 0.6 %: `docs/validation.md`,
-//!   "The cut-off with the slip-line tip").
+//!   "The cut-off with the slip-line tip"). At 96 rows the slip line shows
+//!   what it is under a flat punch: the punch's slip-line field, at 45°
+//!   from the rim, where the plugging band runs along the flight. Case
+//!   I's tip stepped inward twice before the compression gate stopped it
+//!   and ran down 1.35 mm inside the rim (v_r 239.21 m/s, still within
+//!   1 %); with the gate read over `ℓ` it ran to the axis. Case II's tip
+//!   was held by the gate for 20 µs (v_r −11 %). (`docs/validation.md`,
+//!   "The cut-off with the slip-line tip at 96 rows".)
 //! - **The compression gate on the tip** (`tip_min_triaxiality`, default
 //!   −1/3, the nucleation cut-off below). A candidate whose own
 //!   triaxiality is below the cut-off is passed over however damaged it
