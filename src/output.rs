@@ -454,7 +454,7 @@ impl OutputWriter {
             let stopped = tracker.stopped_for(sim.time).is_some_and(|t| t >= wait);
             // Free for `wait` since the later of the release and the cut, or
             // since the release once through the target.
-            let passed = through.is_some_and(|p| s.position.dot(&dir) >= p);
+            let passed = crate::residual::is_through(s.position.dot(&dir), through);
             let free = (passed || cut.is_some_and(|c| sim.time - c >= wait))
                 && tracker.free_for(sim.time).is_some_and(|t| t >= wait);
             moving += 1;

@@ -72,6 +72,13 @@ pub fn through_at(nose: Real, target: (Real, Real)) -> Real {
     far + (far - near) - nose
 }
 
+/// Whether a projectile at `position` along its flight (`x·d` of its body
+/// frame, m) is through its target, given the mark [`through_at`] (`None`
+/// where it is not known): the one test of the verdict and the early stop.
+pub fn is_through(position: Real, through: Option<Real>) -> bool {
+    through.is_some_and(|p| position >= p)
+}
+
 /// Unit vector along `velocity`, zero for a body at rest.
 pub fn flight_direction(velocity: Vec2) -> Vec2 {
     let n = velocity.norm();
@@ -203,7 +210,7 @@ pub fn verdict(
         return Verdict::Held { since };
     }
     let free = tracker.free_for(end).is_some_and(|f| f >= FREE_FLIGHT);
-    let plug = plug || through.is_some_and(|p| position >= p);
+    let plug = plug || is_through(position, through);
     match (plug, free) {
         (true, true) => Verdict::Perforated { residual: speed, since: tracker.last_loaded.unwrap_or(end) },
         _ => Verdict::Undecided { speed, plug, free },

@@ -352,8 +352,9 @@
 //!   "The cut-off with the slip-line tip"). At 96 rows the slip line shows
 //!   what it is under a flat punch: the punch's slip-line field, at 45°
 //!   from the rim, where the plugging band runs along the flight. Case
-//!   I's tip stepped inward twice before the compression gate stopped it
-//!   and ran down 1.35 mm inside the rim (v_r 239.21 m/s, still within
+//!   I's tip took three short runs of 45° steps (inward, outward, inward)
+//!   before the compression gate stopped them, and ran down 1.35 mm
+//!   inside the rim (v_r 239.21 m/s, still within
 //!   1 %); with the gate read over `ℓ` it ran to the axis. Case II's tip
 //!   was held by the gate for 20 µs (v_r −11 %). (`docs/validation.md`,
 //!   "The cut-off with the slip-line tip at 96 rows".)
