@@ -409,6 +409,38 @@ fn the_tip_gate_over_a_length() {
     }
 }
 
+/// The vertices of the one crack grown by `calls` growth stages with
+/// `tip_direction`, on a 21 × 21 lattice failed everywhere, most at the
+/// top centre (one core there), after `prepare` has set its stress or
+/// velocity.
+fn steered_path(tip_direction: TipDirection, calls: usize, prepare: impl Fn(&mut Model)) -> Vec<Vec2> {
+    let mut m = plate(21, 21);
+    set_field(&mut m, |x| 0.5 + 1e-3 * (x.y / H) - 1e-3 * ((x.x - 10.0 * H).abs() / H));
+    prepare(&mut m);
+    let mut g = CrackGrowth::new(FractureParameters { tip_direction, ..params(Criterion::EffectiveStrain) });
+    drive(&mut m, &mut g, calls);
+    assert_eq!(g.cracks.len(), 1, "one crack");
+    g.cracks[0].vertices.iter().map(|v| v.x0).collect()
+}
+
+/// The top centre of [`steered_path`]'s lattice, where its crack nucleates.
+const TOP_CENTRE: Vec2 = Vec2::new(10.0 * H, 20.0 * H);
+
+/// `vertices` start at the top centre and lie on the lattice line through
+/// it along `step`, each ahead of the start (`what` names the case).
+fn assert_on_line(vertices: &[Vec2], step: Vec2, what: &str) {
+    assert!(vertices.len() >= 5, "{what}: {} vertices", vertices.len());
+    let start = vertices[0];
+    assert!((start - TOP_CENTRE).norm() < 1e-9 * H, "{what}: nucleated at {start:?}");
+    for (k, x) in vertices.iter().enumerate() {
+        // on the line, one lattice step `step` (or a multiple along it) per vertex
+        let r = (x - start) / H;
+        let off_line = (r.x * step.y - r.y * step.x).abs() / step.norm();
+        assert!(off_line < 1e-9, "{what}: vertex {k} at {r:?} spacings off the line {step:?}");
+        assert!(r.dot(&step) >= 0.0, "{what}: vertex {k} behind the start");
+    }
+}
+
 /// `tip_direction = "max_shear"`: in a plate failed everywhere (every
 /// candidate meets the criterion, so only the direction rule decides),
 /// under pure shear stress `τ_xy` the current slip lines are x and y; the
@@ -420,38 +452,66 @@ fn the_tip_gate_over_a_length() {
 /// `geometry::max_shear_direction`, tested against closed forms there).
 #[test]
 fn crack_follows_the_slip_line_pulled_back() {
-    let (nx, ny) = (21, 21);
-    let xc = 10.0 * H;
-    let top = (ny - 1) as Real * H;
-    let path = |gamma: Real| {
-        let mut m = plate(nx, ny);
-        // failed everywhere, highest at the top centre: one core there
-        set_field(&mut m, |x| 0.5 + 1e-3 * (x.y / H) - 1e-3 * ((x.x - xc).abs() / H));
-        for q in 0..m.quad.len() {
-            m.quad.tau[q] = Block2 { xx: 0.0, xy: 1e8, yx: 1e8, yy: 0.0, zz: 0.0 };
-            m.quad.f[q] = Block2 { xx: 1.0, xy: gamma, yx: 0.0, yy: 1.0, zz: 1.0 };
-        }
-        let mut g = CrackGrowth::new(FractureParameters {
-            tip_direction: TipDirection::MaxShear,
-            ..params(Criterion::EffectiveStrain)
-        });
-        drive(&mut m, &mut g, 6);
-        assert_eq!(g.cracks.len(), 1, "one crack");
-        g.cracks[0].vertices.iter().map(|v| v.x0).collect::<Vec<_>>()
-    };
     for (gamma, step) in [(0.0, Vec2::new(0.0, -1.0)), (0.5, Vec2::new(1.0, -2.0))] {
-        let vertices = path(gamma);
-        assert!(vertices.len() >= 5, "γ = {gamma}: {} vertices", vertices.len());
-        let start = vertices[0];
-        assert!((start - Vec2::new(xc, top)).norm() < 1e-9 * H, "γ = {gamma}: nucleated at {start:?}");
-        for (k, x) in vertices.iter().enumerate() {
-            // on the line, one lattice step `step` (or a multiple along it) per vertex
-            let r = (x - start) / H;
-            let off_line = (r.x * step.y - r.y * step.x).abs() / step.norm();
-            assert!(off_line < 1e-9, "γ = {gamma}: vertex {k} at {r:?} spacings off the line {step:?}");
-            assert!(r.dot(&step) >= 0.0, "γ = {gamma}: vertex {k} behind the start");
-        }
+        let vertices = steered_path(TipDirection::MaxShear, 6, |m| {
+            for q in 0..m.quad.len() {
+                m.quad.tau[q] = Block2 { xx: 0.0, xy: 1e8, yx: 1e8, yy: 0.0, zz: 0.0 };
+                m.quad.f[q] = Block2 { xx: 1.0, xy: gamma, yx: 0.0, yy: 1.0, zz: 1.0 };
+            }
+        });
+        assert_on_line(&vertices, step, &format!("γ = {gamma}"));
     }
+}
+
+/// `tip_direction = "velocity_jump"` reads the velocity field, not the
+/// stress: under a stress whose slip lines are x and y, a band sliding
+/// with the normal `n` (a shear flow `v = a (n·(X − X_c))`, `a ⊥ n`,
+/// whose RK gradient is `a ⊗ n` exactly) takes the crack along the
+/// lattice direction normal to `n`, `(0, −1)` for `n = x`, `(1, −2)` for
+/// `n = (2, 1)/√5`, whichever way it slides;
+/// `geometry::velocity_jump_direction` is tested against closed forms.
+#[test]
+fn crack_follows_the_velocity_jump() {
+    let inclined = Vec2::new(2.0, 1.0) / 5f64.sqrt();
+    let along = Vec2::new(1.0, -2.0) / 5f64.sqrt();
+    for (n, a, step) in [
+        (Vec2::new(1.0, 0.0), Vec2::new(0.0, -1.0), Vec2::new(0.0, -1.0)),
+        (Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0), Vec2::new(0.0, -1.0)),
+        (inclined, along, Vec2::new(1.0, -2.0)),
+        (inclined, -along, Vec2::new(1.0, -2.0)),
+    ] {
+        let vertices = steered_path(TipDirection::VelocityJump, 6, |m| {
+            for q in 0..m.quad.len() {
+                m.quad.tau[q] = Block2 { xx: 0.0, xy: 1e8, yx: 1e8, yy: 0.0, zz: 0.0 };
+            }
+            for i in 0..m.particles.len() {
+                m.particles.v[i] = a * (n.dot(&(m.particles.x0[i] - TOP_CENTRE)) / H);
+            }
+        });
+        assert_on_line(&vertices, step, &format!("n = {n:?}, a = {a:?}"));
+    }
+}
+
+/// `"velocity_jump"` heads for the band's centre line, not only along
+/// it: a crack nucleated two spacings beside a sliding band (a plug's
+/// velocity ramped to rest over two spacings, `v_y` linear in `x` there)
+/// turns over to the band's centre column within `ℓ` and runs down it,
+/// where the direction alone would have run straight down beside it
+/// (`geometry::band_aim`).
+#[test]
+fn crack_heads_for_the_sliding_band() {
+    let band = TOP_CENTRE.x + 2.0 * H;
+    let vertices = steered_path(TipDirection::VelocityJump, 10, |m| {
+        for i in 0..m.particles.len() {
+            let s = ((band + H - m.particles.x0[i].x) / (2.0 * H)).clamp(0.0, 1.0);
+            m.particles.v[i] = Vec2::new(0.0, -100.0 * s);
+        }
+    });
+    let xs: Vec<Real> = vertices.iter().map(|v| (v.x - TOP_CENTRE.x) / H).collect();
+    assert!(xs.len() >= 8, "{xs:?}");
+    assert!(xs[0].abs() < 1e-9, "nucleated at the top centre: {xs:?}");
+    assert!(xs.iter().all(|&x| x > -1e-9 && x < 2.0 + 1e-9), "between the start and the band: {xs:?}");
+    assert!(xs[xs.len() - 4..].iter().all(|&x| (x - 2.0).abs() < 1e-9), "down the band's centre: {xs:?}");
 }
 
 /// The triaxiality cut-off: a failed zone under hydrostatic compression
@@ -796,9 +856,11 @@ fn fracture_section_is_validated() {
     assert!(bad.contains("stress"), "{bad}");
     let bad =
         Case::from_str_with(text, "f.toml", &["fracture.tip_direction=\"north\"".to_string()]).unwrap_err().to_string();
-    assert!(bad.contains("north") && bad.contains("max_shear"), "{bad}");
+    assert!(bad.contains("north") && bad.contains("max_shear") && bad.contains("velocity_jump"), "{bad}");
     let slip = Case::from_str_with(text, "f.toml", &["fracture.tip_direction=\"max_shear\"".to_string()]).unwrap();
     assert_eq!(slip.fracture.tip_direction, TipDirection::MaxShear);
+    let jump = Case::from_str_with(text, "f.toml", &["fracture.tip_direction=\"velocity_jump\"".to_string()]).unwrap();
+    assert_eq!(jump.fracture.tip_direction, TipDirection::VelocityJump);
     // a band wider than the averaging length is refused; the non-local criterion parses
     let wide = ["fracture.criterion=\"nonlocal_damage\"".to_string(), "fracture.band_width=2e-3".to_string()];
     let err = Case::from_str_with(text, "f.toml", &wide).unwrap_err().to_string();

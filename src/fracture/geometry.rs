@@ -195,6 +195,58 @@ pub fn max_shear_direction(
     best.map(|(_, d)| d)
 }
 
+/// The direction of the band across which the velocity jumps, through a
+/// point with material velocity gradient `fdot` (`Ḟ = ∇_X v`, in-plane,
+/// reference configuration): the band's normal `N` is the one across
+/// which material slides past material fastest, the largest `|T·Ḟ N|`
+/// (`T ⊥ N`); returned is the band's direction `T`, along `reference`
+/// (up to sign). With `ω = (Ḟ_yx − Ḟ_xy)/2` the spin and `R` the Mohr
+/// radius of the symmetric part (the largest shear rate of the rate of
+/// deformation), `T·Ḟ N = ω + R cos(2θ − φ)` for `N` at angle `θ`, so
+/// the band is the one of the rate of deformation's two slip lines whose
+/// sense of shear the spin shares: a sliding band `Ḟ = γ̇ T₀ ⊗ N₀` gives
+/// its own `T₀` exactly (not the conjugate line), whatever is added
+/// along it; a spin-free rate (a pure compression) leaves the two slip
+/// lines at ±45° to its axes and the one nearer `reference` is taken.
+/// `None` where no band is preferred (`R = 0`: a rest, a rigid spin, a
+/// uniform dilatation). The crack-tip direction `tip_direction =
+/// "velocity_jump"` (module doc of [`crate::fracture`]); in 3D the same
+/// reading gives the plane of the largest sliding rate.
+pub fn velocity_jump_direction(fdot: &nalgebra::Matrix2<Real>, reference: &Vec2) -> Option<Vec2> {
+    let (a, b, c, d) = (fdot[(0, 0)], fdot[(0, 1)], fdot[(1, 0)], fdot[(1, 1)]);
+    let spin = 0.5 * (c - b);
+    let (p, q) = (0.5 * (c + b), 0.5 * (d - a));
+    let radius = p.hypot(q);
+    if radius.is_nan() || radius <= 1e-9 * (radius + spin.abs()) || reference.norm() == 0.0 {
+        return None;
+    }
+    let phi = q.atan2(p);
+    let band = |theta: Real| Vec2::new(-theta.sin(), theta.cos());
+    let along = |t: Vec2| if t.dot(reference) < 0.0 { -t } else { t };
+    let first = along(band(0.5 * phi));
+    let second = along(band(0.5 * phi + 0.5 * std::f64::consts::PI));
+    Some(if spin > 0.0 {
+        first
+    } else if spin < 0.0 {
+        second
+    } else if first.dot(reference) >= second.dot(reference) {
+        first
+    } else {
+        second
+    })
+}
+
+/// Where a crack tip heads for along a band of direction `along`
+/// (unit) whose centre line lies `offset` from the tip across it (along
+/// `left_normal(along)`): the point on the centre line `length` ahead,
+/// as a unit vector. A tip on the centre line runs along it; one off it
+/// turns back by `atan(offset/length)`, so a step off the band is
+/// undone within `length` instead of carried on (the tip direction
+/// `"velocity_jump"`, with `length = ℓ`).
+pub fn band_aim(along: &Vec2, offset: Real, length: Real) -> Vec2 {
+    (along * length + left_normal(along) * offset).normalize()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -301,5 +353,67 @@ mod tests {
         let t = left_normal(&n);
         let radius = (0.25 * (tau[(0, 0)] - tau[(1, 1)]).powi(2) + tau[(0, 1)].powi(2)).sqrt();
         assert!(((t.transpose() * tau * n)[0].abs() - radius).abs() < 1e-12);
+    }
+
+    #[test]
+    fn velocity_jump_direction_runs_along_a_sliding_band() {
+        use nalgebra::Matrix2;
+        // a block sliding down (−y) past its surroundings across a band
+        // whose normal is x: Ḟ = [v] ⊗ N / w = (0, −1) ⊗ (1, 0)
+        let plug = Matrix2::new(0.0, 0.0, -1.0, 0.0);
+        let d = velocity_jump_direction(&plug, &v(0.1, -1.0)).unwrap();
+        assert!((d - v(0.0, -1.0)).norm() < 1e-12, "{d}");
+        // sliding up instead, and a reference nearer the conjugate line
+        // (x): the band is still along y
+        let d = velocity_jump_direction(&-plug, &v(1.0, -0.9)).unwrap();
+        assert!((d - v(0.0, -1.0)).norm() < 1e-12, "{d}");
+        // simple shear along x (v_x = γ̇ y) runs along x, whatever the reference
+        let d = velocity_jump_direction(&Matrix2::new(0.0, 1.0, 0.0, 0.0), &v(1.0, 1.5)).unwrap();
+        assert!((d - v(1.0, 0.0)).norm() < 1e-12, "{d}");
+        // a band inclined at 30° from x, N = (−sin 30°, cos 30°), sliding
+        // either way: the band's own direction T
+        let a = 30f64.to_radians();
+        let (t, n) = (v(a.cos(), a.sin()), v(-a.sin(), a.cos()));
+        for g in [2.0, -2.0] {
+            let d = velocity_jump_direction(&(t * n.transpose() * g), &v(1.0, -0.5)).unwrap();
+            assert!((d - t).norm() < 1e-12, "γ̇ = {g}: {d}");
+            // with a compression across it and a stretch along it the band
+            // tilts: to the normal of the largest |T·Ḟ N| of a fine sweep
+            let fdot = t * n.transpose() * g - n * n.transpose() * 0.3 + t * t.transpose() * 0.3;
+            let d = velocity_jump_direction(&fdot, &v(1.0, -0.5)).unwrap();
+            let rate = |theta: Real| {
+                let (nn, tt) = (v(theta.cos(), theta.sin()), v(-theta.sin(), theta.cos()));
+                (tt.transpose() * fdot * nn)[0].abs()
+            };
+            let sweep = (0..36000).map(|k| k as Real * PI / 36000.0);
+            let theta = sweep.max_by(|x, y| rate(*x).total_cmp(&rate(*y))).unwrap();
+            let expected = v(-theta.sin(), theta.cos());
+            assert!(d.dot(&expected).abs() > (1e-4f64).cos(), "γ̇ = {g}: {d} against {expected}");
+            assert!(d.dot(&t) > (10f64.to_radians()).cos(), "γ̇ = {g}: {d} within 10° of the band");
+        }
+        // a pure compression along y has no spin: its slip lines at ±45°,
+        // the one nearer the reference
+        let squeeze = Matrix2::new(0.0, 0.0, 0.0, -1.0);
+        let d = velocity_jump_direction(&squeeze, &v(0.2, -1.0)).unwrap();
+        assert!((d - v(1.0, -1.0) / 2f64.sqrt()).norm() < 1e-12, "{d}");
+        let d = velocity_jump_direction(&squeeze, &v(-0.2, -1.0)).unwrap();
+        assert!((d - v(-1.0, -1.0) / 2f64.sqrt()).norm() < 1e-12, "{d}");
+        // a rest, a rigid spin and a uniform dilatation prefer none
+        assert!(velocity_jump_direction(&Matrix2::zeros(), &v(1.0, 0.0)).is_none());
+        assert!(velocity_jump_direction(&Matrix2::new(0.0, -2.0, 2.0, 0.0), &v(1.0, 0.0)).is_none());
+        assert!(velocity_jump_direction(&Matrix2::identity(), &v(1.0, 0.0)).is_none());
+    }
+
+    #[test]
+    fn band_aim_turns_back_to_the_centre_line() {
+        let down = v(0.0, -1.0);
+        // on the centre line: along it
+        assert!((band_aim(&down, 0.0, 1e-3) - down).norm() < 1e-15);
+        // the centre line 1 mm to the left of a downward band (+x): 45°
+        // towards it at ℓ = 1 mm, atan(1/2) at ℓ = 2 mm
+        let d = band_aim(&down, 1e-3, 1e-3);
+        assert!((d - v(1.0, -1.0) / 2f64.sqrt()).norm() < 1e-12, "{d}");
+        let d = band_aim(&down, -1e-3, 2e-3);
+        assert!((d.x.atan2(-d.y) + 0.5f64.atan()).abs() < 1e-12, "{d}");
     }
 }

@@ -4,8 +4,8 @@
 //! [`crate::fracture`] for the choices and deviations.
 
 use super::geometry::{
-    closest_point_on_segment, left_bisector, left_normal, max_shear_direction, point_segment_distance, sector_angles,
-    sector_contains, widest_empty_sector,
+    band_aim, closest_point_on_segment, left_bisector, left_normal, max_shear_direction, point_segment_distance,
+    sector_angles, sector_contains, velocity_jump_direction, widest_empty_sector,
 };
 use super::nonlocal::NonlocalAverage;
 use super::visibility::{CrackSegments, CrackVisibility};
@@ -113,6 +113,11 @@ where
 fn in_plane_matrix(b: &crate::math::Block2) -> Matrix2<Real> {
     Matrix2::new(b.xx, b.xy, b.yx, b.yy)
 }
+
+/// How far ahead of a tip (along the crack, as a fraction of `ℓ`) the
+/// sight lines of the band reading of `tip_direction = "velocity_jump"`
+/// start: off the crack's line, so that both faces are seen.
+const EYE_AHEAD: Real = 1e-3;
 
 /// A segment may not pass within this fraction of a particle's spacing of
 /// a particle it does not end at.
@@ -446,11 +451,38 @@ impl CrackGrowth {
     /// length `nonlocal_radius` ([`super::nonlocal`]): the points of its
     /// body within `ℓ` whose sight line to `X_i` crosses no crack.
     pub fn nonlocal_damage(&self, model: &Model, i: usize) -> Real {
+        let (acc, wsum) = self.over_length(model, i, |k| model.quad.damage[k]);
+        if wsum > 0.0 {
+            acc / wsum
+        } else {
+            0.0
+        }
+    }
+
+    /// `(Σ α A f, Σ α A)` of `f` over the ball of [`Self::nonlocal_damage`]
+    /// around particle `i`: the points of its body within `ℓ` whose sight
+    /// line to `X_i` crosses no crack, with the bell weight `α` and the
+    /// reference area `A` of each.
+    fn over_length<T>(&self, model: &Model, i: usize, f: impl Fn(usize) -> T) -> (T, Real)
+    where
+        T: Default + std::ops::AddAssign + std::ops::Mul<Real, Output = T>,
+    {
+        self.over_length_seen_from(model, i, &model.particles.x0[i], f)
+    }
+
+    /// [`Self::over_length`] with the sight lines drawn from `eye` (near
+    /// `X_i`) instead of from `X_i`: a tip particle lies on its crack's
+    /// line and sees one face only; from a point just ahead of it the
+    /// ball takes both.
+    fn over_length_seen_from<T>(&self, model: &Model, i: usize, eye: &Vec2, f: impl Fn(usize) -> T) -> (T, Real)
+    where
+        T: Default + std::ops::AddAssign + std::ops::Mul<Real, Output = T>,
+    {
         let q = &model.quad;
         let av = self.nonlocal.get_or_init(|| NonlocalAverage::new(&q.x0, self.params.nonlocal_radius));
         let (xi, body) = (model.particles.x0[i], model.particles.body[i]);
         let area = |k: usize| q.weight[k] / model.mode.volume_factor(&q.x0[k]);
-        av.average(&xi, &q.x0, area, &q.damage, |k| q.body[k] == body && !self.segments.blocked(&xi, &q.x0[k]))
+        av.sums(&xi, &q.x0, area, f, |k| q.body[k] == body && !self.segments.blocked(eye, &q.x0[k]))
     }
 
     /// The triaxiality that gates a crack tip's step into candidate `i`
@@ -464,12 +496,7 @@ impl CrackGrowth {
         if !self.params.nonlocal_tip_triaxiality {
             return self.triaxiality(model, i);
         }
-        let q = &model.quad;
-        let av = self.nonlocal.get_or_init(|| NonlocalAverage::new(&q.x0, self.params.nonlocal_radius));
-        let (xi, body) = (model.particles.x0[i], model.particles.body[i]);
-        let area = |k: usize| q.weight[k] / model.mode.volume_factor(&q.x0[k]);
-        let include = |k: usize| q.body[k] == body && !self.segments.blocked(&xi, &q.x0[k]);
-        let (sums, _) = av.sums(&xi, &q.x0, area, |k| mean_and_von_mises(&q.tau[k]), include);
+        let (sums, _) = self.over_length(model, i, |k| mean_and_von_mises(&model.quad.tau[k]));
         triaxiality_of(sums)
     }
 
@@ -490,17 +517,42 @@ impl CrackGrowth {
     /// configuration, given the crack's (or, at nucleation, the inward)
     /// direction `reference`: with `tip_direction = "max_shear"` the slip
     /// line through the particle ([`max_shear_direction`] of the lumped
-    /// Kirchhoff stress and deformation gradient), `None` otherwise or
-    /// where the stress has no slip line (module doc of
-    /// [`crate::fracture`], "The tip's direction").
+    /// Kirchhoff stress and deformation gradient), with `"velocity_jump"`
+    /// the band across which the velocity jumps
+    /// ([`velocity_jump_direction`] of `Ḟ = Σ_J v_J ⊗ ∇N_J` summed over
+    /// the ball of [`Self::nonlocal_damage`]: over the material length,
+    /// not the particle's own, which zigzags at 96 rows), aimed at the
+    /// band's centre line one `ℓ` ahead ([`band_aim`]; the centre line
+    /// through the centroid of the sliding rate over the ball);
+    /// `None` with `"most_damaged"` or where the field prefers no direction
+    /// (module doc of [`crate::fracture`], "The tip's direction").
     fn slip_line(&self, model: &Model, i: usize, reference: &Vec2) -> Option<Vec2> {
-        if self.params.tip_direction != TipDirection::MaxShear {
-            return None;
-        }
         let q = &model.quad;
-        let tau = lumped(model, i, Matrix2::zeros(), |k| in_plane_matrix(&q.tau[k]));
-        let f = lumped(model, i, Matrix2::zeros(), |k| in_plane_matrix(&q.f[k]));
-        max_shear_direction(&tau, &f, reference)
+        match self.params.tip_direction {
+            TipDirection::MostDamaged => None,
+            TipDirection::MaxShear => {
+                let tau = lumped(model, i, Matrix2::zeros(), |k| in_plane_matrix(&q.tau[k]));
+                let f = lumped(model, i, Matrix2::zeros(), |k| in_plane_matrix(&q.f[k]));
+                max_shear_direction(&tau, &f, reference)
+            }
+            TipDirection::VelocityJump => {
+                let v = &model.particles.v;
+                let fdot = |k: usize| model.qp_shape.gradient_pair(k, v, v).0;
+                let xi = model.particles.x0[i];
+                let eye = xi + reference.normalize() * (EYE_AHEAD * self.params.nonlocal_radius);
+                let (sum, _) = self.over_length_seen_from(model, i, &eye, fdot);
+                let along = velocity_jump_direction(&sum, reference)?;
+                // where across the ball the band lies: the centroid of
+                // the sliding rate on the band's plane
+                let normal = left_normal(&along);
+                let (moments, _) = self.over_length_seen_from(model, i, &eye, |k| {
+                    let rate = (along.transpose() * fdot(k) * normal)[0].abs();
+                    nalgebra::Vector3::new(rate * (q.x0[k] - xi).dot(&normal), 0.0, rate)
+                });
+                let offset = if moments.z > 0.0 { moments.x / moments.z } else { 0.0 };
+                Some(band_aim(&along, offset, self.params.nonlocal_radius))
+            }
+        }
     }
 
     /// How a candidate `j` at `r` from the tip ranks (larger first): its

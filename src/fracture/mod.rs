@@ -358,6 +358,32 @@
 //!   1 %); with the gate read over `ℓ` it ran to the axis. Case II's tip
 //!   was held by the gate for 20 µs (v_r −11 %). (`docs/validation.md`,
 //!   "The cut-off with the slip-line tip at 96 rows".)
+//!   `"velocity_jump"` reads the kinematics instead of the stress: the
+//!   band across which material slides past material fastest, the
+//!   largest `|T·Ḟ N|` over in-plane normals `N` (`T ⊥ N`) of the
+//!   material velocity gradient `Ḟ = Σ_J v_J ⊗ ∇N_J` summed over the
+//!   ball of the damage average (radius `ℓ`, the same sight lines;
+//!   [`geometry::velocity_jump_direction`]). A plug punched out slides
+//!   along the flight past the ring, so `Ḟ ≈ [v] ⊗ N/w` there picks the
+//!   band along the flight, not the punch's 45° slip line: of the rate of
+//!   deformation's two slip lines it is the one whose sense of shear the
+//!   spin shares. Why not the dominant singular vector of `Ḟ` (tried
+//!   first): it counts the compression under the punch (`∂v_y/∂y`) as a
+//!   jump and turned Case I's 96-row crack inward to r = 8.65 mm. Why
+//!   over `ℓ`: at 96 rows the particle's own `Ḟ` (lumped) let the crack
+//!   zigzag in 45° steps across 1.2 mm. Tested against closed forms
+//!   (sliding bands either way, a compression, a spin, a dilatation,
+//!   a sweep of the sliding rate) and on a lattice path
+//!   (`crack_follows_the_velocity_jump`). Not objective under a
+//!   superposed rigid spin (the spin is what picks the band); a plug's
+//!   rotation is small. In 3D the same sum gives the plane of the
+//!   largest sliding rate per crack-front vertex. Measured
+//!   (`docs/validation.md`, "A crack tip along the velocity jump"): at 48
+//!   and 96 rows Case I's crack follows the continuum's shear band, which
+//!   lies at one radius at both (fracture off) but turns inward under the
+//!   projectile, so the plug is narrower than the projectile; the 24-row
+//!   crack (`ℓ` = 2.2 spacings) cannot follow it. An option, not the
+//!   default.
 //! - **The compression gate on the tip** (`tip_min_triaxiality`, default
 //!   −1/3, the nucleation cut-off below). A candidate whose own
 //!   triaxiality is below the cut-off is passed over however damaged it
@@ -450,6 +476,13 @@ pub enum TipDirection {
     /// ([`geometry::max_shear_direction`]); a lattice-independent
     /// direction (issue #19, optional).
     MaxShear,
+    /// The one nearest in angle to the band across which the velocity
+    /// jumps: normal to the direction in which the velocity changes
+    /// fastest in the reference configuration, the dominant right singular
+    /// vector of the material velocity gradient `Ḟ`
+    /// ([`geometry::velocity_jump_direction`]); a kinematic,
+    /// lattice-independent direction (issue #19, optional).
+    VelocityJump,
 }
 
 /// `[fracture]`: crack growth parameters (SPEC §9).
@@ -532,8 +565,9 @@ pub struct FractureParameters {
     /// the first inverted point, failed or not.
     pub erode_inverted: bool,
     /// Which candidate the tip steps to: `"most_damaged"` (the default,
-    /// \[RL10\]'s rule) or `"max_shear"` (the one nearest to the slip line
-    /// through the tip; [`TipDirection`]).
+    /// \[RL10\]'s rule), `"max_shear"` (the one nearest to the slip line
+    /// through the tip) or `"velocity_jump"` (the one nearest to where the
+    /// band across which the velocity jumps leads; [`TipDirection`]).
     pub tip_direction: TipDirection,
     /// A growing tip steps only to a candidate (and joins another crack
     /// only from a tip) whose stress triaxiality `σ_m/σ_eq` is at least
