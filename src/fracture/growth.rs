@@ -545,11 +545,12 @@ impl CrackGrowth {
                 // where across the ball the band lies: the centroid of
                 // the sliding rate on the band's plane
                 let normal = left_normal(&along);
+                // (Σ α A s d, Σ α A s) of the sliding rate s at signed distance d
                 let (moments, _) = self.over_length_seen_from(model, i, &eye, |k| {
                     let rate = (along.transpose() * fdot(k) * normal)[0].abs();
-                    nalgebra::Vector3::new(rate * (q.x0[k] - xi).dot(&normal), 0.0, rate)
+                    Vec2::new(rate * (q.x0[k] - xi).dot(&normal), rate)
                 });
-                let offset = if moments.z > 0.0 { moments.x / moments.z } else { 0.0 };
+                let offset = if moments.y > 0.0 { moments.x / moments.y } else { 0.0 };
                 Some(band_aim(&along, offset, self.params.nonlocal_radius))
             }
         }
