@@ -205,8 +205,8 @@ pub fn max_shear_direction(
 /// deformation), `T·Ḟ N = ω + R cos(2θ − φ)` for `N` at angle `θ`, so
 /// the band is the one of the rate of deformation's two slip lines whose
 /// sense of shear the spin shares: a sliding band `Ḟ = γ̇ T₀ ⊗ N₀` gives
-/// its own `T₀` exactly (not the conjugate line), whatever is added
-/// along it; a spin-free rate (a pure compression) leaves the two slip
+/// its own `T₀` exactly (not the conjugate line; a compression across it
+/// or a stretch along it tilts the answer); a spin-free rate (a pure compression) leaves the two slip
 /// lines at ±45° to its axes and the one nearer `reference` is taken.
 /// `None` where no band is preferred (`R = 0`: a rest, a rigid spin, a
 /// uniform dilatation). The crack-tip direction `tip_direction =

@@ -526,7 +526,7 @@ impl CrackGrowth {
     /// through the centroid of the sliding rate over the ball);
     /// `None` with `"most_damaged"` or where the field prefers no direction
     /// (module doc of [`crate::fracture`], "The tip's direction").
-    fn slip_line(&self, model: &Model, i: usize, reference: &Vec2) -> Option<Vec2> {
+    fn heading(&self, model: &Model, i: usize, reference: &Vec2) -> Option<Vec2> {
         let q = &model.quad;
         match self.params.tip_direction {
             TipDirection::MostDamaged => None,
@@ -557,10 +557,10 @@ impl CrackGrowth {
     }
 
     /// How a candidate `j` at `r` from the tip ranks (larger first): its
-    /// [`Self::path_value`], or with a slip line its closeness in angle to
-    /// it.
-    fn rank(&self, model: &Model, j: usize, value: Real, r: &Vec2, slip: Option<&Vec2>) -> Real {
-        match slip {
+    /// [`Self::path_value`], or with a heading ([`Self::heading`]) its
+    /// closeness in angle to it.
+    fn rank(&self, model: &Model, j: usize, value: Real, r: &Vec2, heading: Option<&Vec2>) -> Real {
+        match heading {
             Some(n) => -angle(r, n),
             None => self.path_value(model, j, value),
         }
@@ -653,7 +653,7 @@ impl CrackGrowth {
                 continue;
             }
             let half_fan = 0.5 * self.params.fan_angle.to_radians();
-            let slip = self.slip_line(model, tip, &d);
+            let heading = self.heading(model, tip, &d);
             // (rank, criterion value, particle)
             let mut best: Option<(Real, Real, usize)> = None;
             for &j in &circle {
@@ -665,7 +665,7 @@ impl CrackGrowth {
                     continue;
                 }
                 let value = self.criterion_value(model, j);
-                let rank = self.rank(model, j, value, &r, slip.as_ref());
+                let rank = self.rank(model, j, value, &r, heading.as_ref());
                 if value < critical || best.is_some_and(|(bv, _, _)| bv >= rank) {
                     continue;
                 }
@@ -860,7 +860,7 @@ impl CrackGrowth {
                 continue;
             }
             let inward = self.outward_normal(model, i).map(|n| -n);
-            let slip = inward.and_then(|n| self.slip_line(model, i, &n));
+            let heading = inward.and_then(|n| self.heading(model, i, &n));
             // (rank, criterion value, particle)
             let mut best: Option<(Real, Real, usize)> = None;
             for j in self.circle(model, i) {
@@ -869,7 +869,7 @@ impl CrackGrowth {
                     continue;
                 }
                 let value = self.criterion_value(model, j);
-                let rank = self.rank(model, j, value, &(model.particles.x0[j] - xi), slip.as_ref());
+                let rank = self.rank(model, j, value, &(model.particles.x0[j] - xi), heading.as_ref());
                 if value < critical || best.is_some_and(|(bv, _, _)| bv >= rank) {
                     continue;
                 }
