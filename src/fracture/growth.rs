@@ -451,12 +451,7 @@ impl CrackGrowth {
     /// length `nonlocal_radius` ([`super::nonlocal`]): the points of its
     /// body within `ℓ` whose sight line to `X_i` crosses no crack.
     pub fn nonlocal_damage(&self, model: &Model, i: usize) -> Real {
-        let (acc, wsum) = self.over_length(model, i, |k| model.quad.damage[k]);
-        if wsum > 0.0 {
-            acc / wsum
-        } else {
-            0.0
-        }
+        super::nonlocal::mean(self.over_length(model, i, |k| model.quad.damage[k]))
     }
 
     /// `(Σ α A f, Σ α A)` of `f` over the ball of [`Self::nonlocal_damage`]

@@ -381,9 +381,13 @@
 //!   (`docs/validation.md`, "A crack tip along the velocity jump"): at 48
 //!   and 96 rows Case I's crack follows the continuum's shear band, which
 //!   lies at one radius at both (fracture off) but turns inward under the
-//!   projectile, so the plug is narrower than the projectile; the 24-row
-//!   crack (`ℓ` = 2.2 spacings) cannot follow it. An option, not the
-//!   default.
+//!   projectile, so the plug's base is cut inside the projectile's radius
+//!   (reference positions); the 24-row crack (`ℓ` = 2.2 spacings) cannot
+//!   follow it. Under the flat punch the plug's head spreads wider than
+//!   the projectile, so with `contact.self_contact` off that head passes
+//!   through its own ring and throws the lip (1.29 km/s at 96 rows;
+//!   `docs/validation.md`, "A plug wider than its hole"). An option, not
+//!   the default.
 //! - **The compression gate on the tip** (`tip_min_triaxiality`, default
 //!   −1/3, the nucleation cut-off below). A candidate whose own
 //!   triaxiality is below the cut-off is passed over however damaged it
@@ -476,11 +480,12 @@ pub enum TipDirection {
     /// ([`geometry::max_shear_direction`]); a lattice-independent
     /// direction (issue #19, optional).
     MaxShear,
-    /// The one nearest in angle to the band across which the velocity
-    /// jumps: normal to the direction in which the velocity changes
-    /// fastest in the reference configuration, the dominant right singular
-    /// vector of the material velocity gradient `Ḟ`
-    /// ([`geometry::velocity_jump_direction`]); a kinematic,
+    /// The one nearest in angle to where the band across which the
+    /// velocity jumps leads: the band whose normal `N` carries the largest
+    /// sliding rate `|T·Ḟ N|` of the material velocity gradient `Ḟ`
+    /// summed over the ball of radius `ℓ`
+    /// ([`geometry::velocity_jump_direction`]), aimed at its centre line
+    /// one `ℓ` ahead ([`geometry::band_aim`]); a kinematic,
     /// lattice-independent direction (issue #19, optional).
     VelocityJump,
 }

@@ -145,12 +145,17 @@ impl NonlocalAverage {
         f: &[Real],
         include: impl Fn(usize) -> bool,
     ) -> Real {
-        let (acc, wsum) = self.sums(x, x0, area, |q| f[q], include);
-        if wsum > 0.0 {
-            acc / wsum
-        } else {
-            0.0
-        }
+        mean(self.sums(x, x0, area, |q| f[q], include))
+    }
+}
+
+/// The average `Σ α A f / Σ α A` from the pair [`NonlocalAverage::sums`]
+/// returns (0 where no point counts).
+pub fn mean((acc, wsum): (Real, Real)) -> Real {
+    if wsum > 0.0 {
+        acc / wsum
+    } else {
+        0.0
     }
 }
 
