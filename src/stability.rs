@@ -106,6 +106,14 @@ pub struct BoundScratch {
     points: Vec<(Option<Block2>, Real)>,
     /// Per point: `k_q w_q Σ_J |b_J(q)|`.
     row_factor: Vec<Real>,
+    /// Per piece of [`PARALLEL_PIECE`] points, per table entry `k` of its
+    /// points (of point `q`, particle `J`; from the piece's first entry):
+    /// `|b_J(q)| / √m_J`, summed into the point's row factor and read
+    /// again by the particle's bound (written only for points whose
+    /// `k_q w_q` is not zero, and read only for those). One buffer per
+    /// piece, so that the pieces fill theirs side by side and keep them
+    /// from step to step.
+    entries: Vec<Vec<Real>>,
     /// Per particle: the bound `ω_I²`.
     pub bounds: Vec<Real>,
 }
@@ -145,22 +153,39 @@ impl BoundScratch {
             let r = if held_x { None } else { hoop(q) };
             column_norm(&table.grad[k], table.value[k], points[q].0.as_ref(), r) / mass[j].sqrt()
         };
-        self.row_factor.par_iter_mut().with_max_len(PARALLEL_PIECE).enumerate().for_each(|(q, factor)| {
-            let modulus_w = points[q].1;
-            *factor = if modulus_w == 0.0 {
-                0.0
-            } else {
-                let s: Real = table.range(q).map(|k| scaled(k, q, table.index[k] as usize)).sum();
-                s * modulus_w
-            };
-        });
-        let (gather, row_factor) = (&model.gather, &self.row_factor);
+        // The entries of each piece of PARALLEL_PIECE points are one
+        // contiguous run of the table, from the piece's first point's.
+        self.entries.resize_with(quad.len().div_ceil(PARALLEL_PIECE), Vec::new);
+        self.row_factor.par_chunks_mut(PARALLEL_PIECE).zip(&mut self.entries).enumerate().for_each(
+            |(n, (factors, entries))| {
+                let q0 = n * PARALLEL_PIECE;
+                let first = table.offsets[q0];
+                entries.resize(table.offsets[q0 + factors.len()] - first, 0.0);
+                for (dq, factor) in factors.iter_mut().enumerate() {
+                    let q = q0 + dq;
+                    let modulus_w = points[q].1;
+                    *factor = if modulus_w == 0.0 {
+                        0.0
+                    } else {
+                        let mut s = 0.0;
+                        for k in table.range(q) {
+                            let e = scaled(k, q, table.index[k] as usize);
+                            entries[k - first] = e;
+                            s += e;
+                        }
+                        s * modulus_w
+                    };
+                }
+            },
+        );
+        let (gather, row_factor, entries) = (&model.gather, &self.row_factor, &self.entries);
         self.bounds.par_iter_mut().with_max_len(PARALLEL_PIECE).enumerate().for_each(|(i, bound)| {
             let mut sum = 0.0;
             for j in gather.range(i) {
                 let (k, q) = (gather.entry[j] as usize, gather.point[j] as usize);
                 if row_factor[q] != 0.0 {
-                    sum += scaled(k, q, i) * row_factor[q];
+                    let q0 = q - q % PARALLEL_PIECE;
+                    sum += entries[q / PARALLEL_PIECE][k - table.offsets[q0]] * row_factor[q];
                 }
             }
             *bound = sum;

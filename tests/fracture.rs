@@ -1142,6 +1142,71 @@ fn crack_tip_advances_at_the_prescribed_speed() {
     assert!(advances >= 30 && track.len() <= advances + 1, "{advances} advances in {} stages", track.len());
 }
 
+/// Two cracks that passed side by side (`CrackGrowth::junction`, found
+/// on Case II's plate at 96 rows): a crack from the top ran down column 8,
+/// stepped aside to column 7 and on down beside a crack from the bottom
+/// surface, whose tip, one spacing below the first's path, is failed but
+/// has nowhere to go: straight ahead is the first crack's face, up-left is
+/// hidden by it, and up-right lies intact material that has not failed.
+/// No intact particle lies between its tip and the first crack's path, so
+/// it joins it there, and the two cut out the piece left of them; a rule
+/// that joins only where every particle ahead is a face or hidden waits
+/// for ever (the up-right particle is intact), and the plug is held by the
+/// bridge the passing cracks leave. The tip is compressed, as under the
+/// projectile's rim: the gate on a tip's steps does not hold a join. The
+/// tip of the first crack, beside the second's path with an intact
+/// particle between it and that path, does not join.
+#[test]
+fn a_tip_beside_another_crack_joins_it_across_no_ligament() {
+    let (nx, ny) = (25, 13);
+    let mut m = plate(nx, ny);
+    non_uniform_velocity(&mut m);
+    // failed left of column 8.5 above row 4.5: the second crack's tip
+    // meets the criterion, the intact particle up-right of it does not,
+    // nor does anything around the first crack's tip
+    set_field(&mut m, |x| if x.x < 8.6 * H && x.y > 4.4 * H { 0.6 } else { 0.0 });
+    let mut g = CrackGrowth::new(FractureParameters {
+        nucleation_distance_factor: 100.0,
+        ..params(Criterion::EffectiveStrain)
+    });
+    let mut top: Vec<(usize, usize)> = (6..ny).rev().map(|j| (8, j)).collect();
+    top.extend([(7, 5), (7, 4), (7, 3)]);
+    let top: Vec<usize> = top.iter().map(|&(i, j)| id(&m, i, j)).collect();
+    g.insert_crack(&mut m, &top, false).unwrap();
+    let bottom: Vec<usize> = (0..=5).map(|j| id(&m, 8, j)).collect();
+    g.insert_crack(&mut m, &bottom, false).unwrap();
+    let tip = id(&m, 8, 5);
+    assert_eq!(g.cracks[1].tip, Some(tip));
+    let critical = g.params.critical_value().unwrap();
+    assert!(g.criterion_value(&m, tip) >= critical, "the second tip has failed");
+    assert!(g.criterion_value(&m, id(&m, 9, 6)) < critical, "up-right of it has not");
+    // Under the projectile's rim, where this was found, the tip is
+    // compressed past the gate on a tip's steps (triaxiality −1.7 here):
+    // the join steps into no material and does not ask it.
+    for q in 0..m.quad.len() {
+        m.quad.tau[q] = Block2 { xx: -3e8, xy: 1e8, yx: 1e8, yy: -3e8, zz: -3e8 };
+    }
+    assert!(g.triaxiality(&m, tip) < g.params.tip_min_triaxiality, "{}", g.triaxiality(&m, tip));
+    assert!(plugsim::plug::plug_particles(&m, &g, 0.0).is_none(), "the bridge between them holds");
+    let events = g.events.len();
+    drive(&mut m, &mut g, 3);
+    let new = &g.events[events..];
+    let joins: Vec<_> = new.iter().filter(|e| e.kind == EventKind::Join).collect();
+    assert_eq!(joins.len(), 1, "{new:?}");
+    assert_eq!(joins[0].crack, 1, "the second crack joins");
+    assert!(new.iter().all(|e| e.crack == 1), "the first crack's tip stays: {new:?}");
+    let c = &g.cracks[1];
+    assert!(c.tip.is_none() && c.arrested.is_some());
+    // on the first crack's path, half a diagonal up-left of the tip
+    let end = c.vertices.last().unwrap().x0;
+    assert!((end - Vec2::new(7.5 * H, 5.5 * H)).norm() < 1e-12, "ends on the first crack's step aside: {end:?}");
+    assert_eq!(g.cracks[0].tip, Some(id(&m, 7, 3)), "the first crack grows on, unchanged");
+    // the piece left of the two joined paths is cut out
+    let plug = plugsim::plug::plug_particles(&m, &g, 0.0).expect("cut out by the two cracks");
+    assert!(plug.iter().all(|&i| m.particles.x0[i].x < 8.5 * H), "left of the joined cracks");
+    assert!(plug.len() > 80, "{} particles", plug.len());
+}
+
 /// Coalescence (`CrackGrowth::junction`): a crack from the top whose tip
 /// is one spacing above a second crack's face (from the bottom surface,
 /// turned sideways under it) has no candidate — every particle ahead is a

@@ -123,6 +123,17 @@ const EYE_AHEAD: Real = 1e-3;
 /// a particle it does not end at.
 const PASS_OVER_FRACTION: Real = 0.1;
 
+/// A particle counts as nearer a junction than the tip
+/// ([`CrackGrowth::junction`]) only by more than this fraction of the
+/// tip's spacing: lattice neighbours at the same distance are not between.
+const LIGAMENT_TOLERANCE: Real = 1e-6;
+
+/// Relative margin below the critical value within which
+/// [`CrackGrowth::may_reach`]'s bound still asks for the average: far
+/// wider than the round-off of a weighted mean (a few ulps), far narrower
+/// than any change of the damage in a step.
+const BOUND_MARGIN: Real = 1e-9;
+
 /// Angle between two non-zero vectors, rad.
 fn angle(a: &Vec2, b: &Vec2) -> Real {
     (a.dot(b) / (a.norm() * b.norm())).clamp(-1.0, 1.0).acos()
@@ -474,15 +485,36 @@ impl CrackGrowth {
         T: Default + std::ops::AddAssign + std::ops::Mul<Real, Output = T>,
     {
         let q = &model.quad;
-        let av = self.nonlocal.get_or_init(|| NonlocalAverage::new(&q.x0, self.params.nonlocal_radius));
+        let av = self.nonlocal_average(model);
         let (xi, body) = (model.particles.x0[i], model.particles.body[i]);
         let area = |k: usize| q.weight[k] / model.mode.volume_factor(&q.x0[k]);
         av.sums(&xi, &q.x0, area, f, |k| q.body[k] == body && !self.segments.blocked(eye, &q.x0[k]))
     }
 
+    /// The quadrature points binned for the averages over `ℓ` (built on
+    /// first use: the points do not move in the reference configuration).
+    fn nonlocal_average(&self, model: &Model) -> &NonlocalAverage {
+        self.nonlocal.get_or_init(|| NonlocalAverage::new(&model.quad.x0, self.params.nonlocal_radius))
+    }
+
+    /// Whether particle `i`'s criterion value may reach `critical`: false
+    /// only where it cannot. With `"nonlocal_damage"`, `maxima` holds the
+    /// largest damage of each cell of the average's points
+    /// ([`NonlocalAverage::cell_maxima`]), and a particle whose ball
+    /// reaches no point as damaged as `critical` cannot average to it
+    /// ([`NonlocalAverage::upper_bound`]; the margin covers the average's
+    /// round-off). This spares the ball sums of the nucleation scan, which
+    /// visits every surface particle each stage, where nothing near has
+    /// failed; the particles it keeps and the values they get are the
+    /// same (`no_average_exceeds_its_cell_bound`).
+    fn may_reach(&self, model: &Model, i: usize, critical: Real, maxima: Option<&[Real]>) -> bool {
+        maxima.is_none_or(|m| {
+            self.nonlocal_average(model).upper_bound(&model.particles.x0[i], m) >= critical * (1.0 - BOUND_MARGIN)
+        })
+    }
+
     /// The triaxiality that gates a crack tip's step into candidate `i`
-    /// (`tip_min_triaxiality`; a join, `Self::junction`, reads the tip's
-    /// own): the particle's own ([`Self::triaxiality`]),
+    /// (`tip_min_triaxiality`): the particle's own ([`Self::triaxiality`]),
     /// or with `nonlocal_tip_triaxiality` the ratio of the mean and von
     /// Mises stresses averaged over `ℓ` with the weights of
     /// [`Self::nonlocal_damage`] (module doc of [`crate::fracture`], "The
@@ -815,6 +847,8 @@ impl CrackGrowth {
         // In parallel (the scan visits every surface particle each step);
         // the collected order is the index order either way.
         let min_radius = self.smallest_ring_radius(model);
+        let maxima = (self.params.criterion == Criterion::NonlocalDamage)
+            .then(|| self.nonlocal_average(model).cell_maxima(|k| model.quad.damage[k]));
         let mut cores: Vec<(Real, usize)> = (0..model.particles.len())
             .into_par_iter()
             .filter(|&i| {
@@ -825,6 +859,7 @@ impl CrackGrowth {
                     && !f.has(ParticleFlags::CRACK_FACE)
                     && !f.has(ParticleFlags::ON_AXIS)
                     && model.particles.x0[i].x >= min_radius
+                    && self.may_reach(model, i, critical, maxima.as_deref())
             })
             .map(|i| (self.criterion_value(model, i), i))
             .filter(|&(v, i)| v >= critical && self.triaxiality(model, i) >= NUCLEATION_MIN_TRIAXIALITY)
@@ -1052,22 +1087,34 @@ impl CrackGrowth {
     /// crack `c`, with no candidate ahead, ends on another crack — the
     /// nearest point of another crack's path (its vertices, not the
     /// extensions) within the tip's circle `R` and inside both fans — if
-    /// the way ahead is cut (every particle of the circle inside both fans
-    /// is a crack face or hidden from the tip by a crack: no intact
-    /// material to cross, which only the criterion may do) and the tip
-    /// itself meets the criterion `critical` and is not compressed
-    /// (triaxiality ≥ −1/3, as every candidate). \[RL10\]'s rules know the
-    /// outer surface only: a tip that reaches another crack's face finds
-    /// every particle ahead a face of that crack or behind it, so it
-    /// neither advances nor arrests, and the ligament it leaves holds the
-    /// plug, which is found between through-cracks only. Found on Case I's
-    /// plate at 96 rows and 116.67 m/s: the ring crack from the corner
-    /// stopped one spacing above a second crack from the bottom face while
-    /// the plug moved away at 41 m/s (docs/validation.md, "The issue's
-    /// ladder"). The same rule carries to 3D as a crack front meeting
-    /// another crack surface. `circle` is the tip's circle, `(d, mean)` its
-    /// fans' directions, as `grow` found them. Test:
-    /// `a_tip_that_reaches_another_crack_joins_it`.
+    /// no intact material lies between them (no particle of the circle
+    /// that is no crack face and is seen from the tip lies nearer that
+    /// point than the tip: such a ligament only the criterion may cut)
+    /// and the tip itself meets the criterion `critical`. The compression
+    /// gate (`tip_min_triaxiality`) is not asked again: it decides where a
+    /// tip may step, and a join steps into no material — the tip passed
+    /// the gate when the crack stepped into it, as a propagation splits
+    /// the tip it leaves without asking. \[RL10\]'s
+    /// rules know the outer surface only: a tip that reaches another
+    /// crack's face finds every particle ahead a face of that crack or
+    /// behind it, so it neither advances nor arrests, and the ligament it
+    /// leaves holds the plug, which is found between through-cracks only.
+    /// Found on Case I's plate at 96 rows and 116.67 m/s: the ring crack
+    /// from the corner stopped one spacing above a second crack from the
+    /// bottom face while the plug moved away at 41 m/s (docs/validation.md,
+    /// "The issue's ladder"). The ligament, not the whole way ahead, is
+    /// what must be cut: first built to join only where every particle
+    /// ahead in the fans was a face or hidden, it left Case II's plate at
+    /// 96 rows (an option's run, "The cut-off with the slip-line tip at 96
+    /// rows") with two cracks passed side by side, one spacing apart: the
+    /// crack from the back face stopped with its tip half a spacing below
+    /// the other's path, its one way across that path cut by it, while
+    /// intact material it could not enter lay beside (docs/validation.md,
+    /// "Cracks that pass side by side"). The same rule carries to 3D as a
+    /// crack front meeting another crack surface. `circle` is the tip's
+    /// circle, `(d, mean)` its fans' directions, as `grow` found them.
+    /// Tests: `a_tip_that_reaches_another_crack_joins_it`,
+    /// `a_tip_beside_another_crack_joins_it_across_no_ligament`.
     fn junction(
         &self,
         model: &Model,
@@ -1079,23 +1126,11 @@ impl CrackGrowth {
         let tip = self.cracks[c].tip?;
         let p = &model.particles;
         let xt = p.x0[tip];
-        if self.criterion_value(model, tip) < critical || self.triaxiality(model, tip) < self.params.tip_min_triaxiality
-        {
+        if self.criterion_value(model, tip) < critical {
             return None;
         }
         let half_fan = 0.5 * self.params.fan_angle.to_radians();
         let in_fans = |r: &Vec2| in_fans(r, &d, &mean, half_fan);
-        // Only where the way ahead is cut: a particle ahead that is no crack
-        // face and is seen from the tip is intact material, which the tip
-        // must cross by the criterion.
-        let open = circle.iter().any(|&j| {
-            in_fans(&(p.x0[j] - xt))
-                && !p.flags[j].has(ParticleFlags::CRACK_FACE)
-                && !self.blocked_from_tip(model, c, j)
-        });
-        if open {
-            return None;
-        }
         let reach = self.params.radius_factor * p.spacing[tip];
         let mut best: Option<(Real, Vec2)> = None;
         for (k, other) in self.cracks.iter().enumerate() {
@@ -1116,7 +1151,16 @@ impl CrackGrowth {
                 }
             }
         }
-        best.map(|(_, x)| x)
+        let (dist, x) = best?;
+        // A particle that is no crack face, is seen from the tip and lies
+        // nearer the junction than the tip is intact material between
+        // them, which the tip must cross by the criterion.
+        let ligament = circle.iter().any(|&j| {
+            (p.x0[j] - x).norm() < dist - LIGAMENT_TOLERANCE * p.spacing[tip]
+                && !p.flags[j].has(ParticleFlags::CRACK_FACE)
+                && !self.blocked_from_tip(model, c, j)
+        });
+        (!ligament).then_some(x)
     }
 
     /// Join: end crack `c` at `junction` on another crack — split the tip

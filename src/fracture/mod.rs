@@ -92,16 +92,23 @@
 //!   empty sector between consecutive particle directions
 //!   (`arrest_at_the_far_surface_without_running_along_it`).
 //! - **Coalescence** (a deviation; `CrackGrowth::junction`): a
-//!   tip with no candidate whose way ahead is cut by another crack (every
-//!   particle of its circle inside its fans a crack face or hidden from it
-//!   by a crack) ends on that crack's path — a last segment to its nearest
-//!   point within `R` inside the fans, split as an arrest (event `join`) —
-//!   if the tip meets the criterion and is not compressed. \[RL10\]'s arrest knows the outer
+//!   tip with no candidate ends on another crack's path — a last segment
+//!   to its nearest point within `R` inside the fans, split as an arrest
+//!   (event `join`) — if no intact material lies between them (no
+//!   particle of the circle that is no crack face and is seen from the
+//!   tip lies nearer that point than the tip), and the tip meets the
+//!   criterion (not the compression gate, which decides where a tip may
+//!   step: a join steps into no material). \[RL10\]'s arrest knows the outer
 //!   surface only; a tip one spacing from another crack's face (every
 //!   particle ahead a face of it or behind it) neither advanced nor
 //!   arrested, and the bridge it left held a plug that moved away at
 //!   41 m/s (Case I's plate, 96 rows, 116.67 m/s; docs/validation.md).
-//!   (`a_tip_that_reaches_another_crack_joins_it`)
+//!   (`a_tip_that_reaches_another_crack_joins_it`) Asking the whole way
+//!   ahead to be cut, as first built, left two cracks that had passed side
+//!   by side one spacing apart unjoined: the tip beside the other's path
+//!   had intact material up its other side that it could not enter
+//!   (Case II's plate at 96 rows; docs/validation.md, "Cracks that pass
+//!   side by side"; `a_tip_beside_another_crack_joins_it_across_no_ligament`).
 //! - The fan is applied twice: candidates lie within `θ_c/2` of the last
 //!   segment's direction (\[RL10\]) **and** of the crack's mean direction
 //!   (nucleation point to tip). With the last segment alone a crack can
@@ -574,9 +581,9 @@ pub struct FractureParameters {
     /// through the tip) or `"velocity_jump"` (the one nearest to where the
     /// band across which the velocity jumps leads; [`TipDirection`]).
     pub tip_direction: TipDirection,
-    /// A growing tip steps only to a candidate (and joins another crack
-    /// only from a tip) whose stress triaxiality `σ_m/σ_eq` is at least
-    /// this, dimensionless, in [−10, 0]. Default −1/3
+    /// A growing tip steps only to a candidate whose stress triaxiality
+    /// `σ_m/σ_eq` is at least this, dimensionless, in [−10, 0] (a join to
+    /// another crack steps into no material and does not ask it again). Default −1/3
     /// ([`growth::NUCLEATION_MIN_TRIAXIALITY`], Bao and Wierzbicki's
     /// cut-off, the one nucleation keeps); −10 lifts it (module doc, "The
     /// compression gate").
@@ -584,8 +591,8 @@ pub struct FractureParameters {
     /// Whether the tip's gate (`tip_min_triaxiality`) on its candidates
     /// reads the triaxiality averaged over `nonlocal_radius` (the ratio of
     /// the averaged mean and von Mises stresses, the ball and weights of
-    /// the damage average) instead of the candidate particle's own; the
-    /// join of a tip to another crack keeps the tip's own. Default false
+    /// the damage average) instead of the candidate particle's own.
+    /// Default false
     /// (module doc, "The compression gate on the tip").
     pub nonlocal_tip_triaxiality: bool,
 }

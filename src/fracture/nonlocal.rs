@@ -136,6 +136,35 @@ impl NonlocalAverage {
         (acc, wsum)
     }
 
+    /// The largest value of `f` over the points binned in each cell, in
+    /// cell order (`−∞` for an empty cell): read with
+    /// [`Self::upper_bound`], it bounds every average about a point
+    /// without visiting its ball.
+    pub fn cell_maxima(&self, f: impl Fn(usize) -> Real) -> Vec<Real> {
+        let (nx, ny) = self.grid.layout().dims();
+        (0..nx * ny)
+            .map(|c| self.grid.cell_items(c).iter().map(|&q| f(q as usize)).fold(Real::NEG_INFINITY, Real::max))
+            .collect()
+    }
+
+    /// The largest of `maxima` ([`Self::cell_maxima`]) over the cells the
+    /// ball about `x` reaches: every point [`Self::sums`] may count lies in
+    /// those cells, and an average of values with positive weights is at
+    /// most their largest, so no average of `f` about `x` exceeds it
+    /// (`−∞` where the ball reaches no cell).
+    pub fn upper_bound(&self, x: &Vec2, maxima: &[Real]) -> Real {
+        let layout = self.grid.layout();
+        let reach = Vec2::repeat(self.radius);
+        let Some(range) = layout.cells_overlapping(&(x - reach), &(x + reach)) else {
+            return Real::NEG_INFINITY;
+        };
+        let nx = layout.dims().0;
+        (range.y0..=range.y1)
+            .flat_map(|iy| (range.x0..=range.x1).map(move |ix| iy * nx + ix))
+            .map(|c| maxima[c])
+            .fold(Real::NEG_INFINITY, Real::max)
+    }
+
     /// The average `Σ α A f / Σ α A` (0 where no point counts).
     pub fn average(
         &self,
@@ -242,6 +271,40 @@ mod tests {
         assert!((a / exact - 1.0).abs() < 0.01, "{a} vs {exact}");
         assert_eq!(band_critical_damage(0.2e-3, l), 0.2e-3 / band_averaging_width(l));
         assert_eq!(band_critical_damage(2e-3, l), 1.0);
+    }
+
+    /// The cell bound is at least every average about a point, with or
+    /// without points left out, and at least the largest value within `ℓ`
+    /// of it: a rough field on a lattice, seen from points off its sites;
+    /// a uniform field's bound is its value.
+    #[test]
+    fn no_average_exceeds_its_cell_bound() {
+        let (h, l) = (0.1e-3, 0.45e-3);
+        let pts = lattice(h, 2e-3);
+        let av = NonlocalAverage::new(&pts, l);
+        // a rough field in [0, 1) (a fixed pseudo-random sequence)
+        let f: Vec<Real> = (0..pts.len()).map(|k| ((k as Real * 0.618_033_988_75).fract() * 7.0).fract()).collect();
+        let maxima = av.cell_maxima(|q| f[q]);
+        let mut checked = 0;
+        for k in (0..pts.len()).step_by(7) {
+            let x = pts[k] + Vec2::new(0.013e-3, -0.029e-3);
+            let bound = av.upper_bound(&x, &maxima);
+            // the largest value within ℓ: the bound is at least that
+            let within = (0..pts.len()).filter(|&q| (pts[q] - x).norm() < l).map(|q| f[q]).fold(0.0, Real::max);
+            assert!(bound >= within, "{bound} < {within}");
+            for keep in [|_: usize| true, |q: usize| !q.is_multiple_of(3)] {
+                let a = av.average(&x, &pts, |_| h * h, &f, keep);
+                assert!(a <= bound, "average {a} above its bound {bound}");
+            }
+            checked += 1;
+        }
+        assert!(checked > 100);
+        // a uniform field: the bound is the value, and so is the average
+        let c = vec![0.37; pts.len()];
+        let x = Vec2::new(0.3e-3, -0.2e-3);
+        assert_eq!(av.upper_bound(&x, &av.cell_maxima(|q| c[q])), 0.37);
+        // far outside the points: no cell, no bound
+        assert_eq!(av.upper_bound(&Vec2::new(1.0, 1.0), &maxima), Real::NEG_INFINITY);
     }
 
     #[test]
