@@ -36,6 +36,12 @@ impl CellRange {
     pub fn cell((ix, iy): (usize, usize)) -> Self {
         CellRange { x0: ix, x1: ix, y0: iy, y1: iy }
     }
+
+    /// The cells' indices `iy nx + ix` in a layout `nx` cells wide, row by
+    /// row (by increasing `iy`, then `ix`); none for an empty range.
+    pub fn indices(self, nx: usize) -> impl Iterator<Item = usize> {
+        (self.y0..=self.y1).flat_map(move |iy| (self.x0..=self.x1).map(move |ix| iy * nx + ix))
+    }
 }
 
 /// Where the cells of a [`CellGrid`] lie: `nx × ny` square cells of edge
@@ -189,7 +195,7 @@ impl CellGrid {
     /// of a cell in ascending order). Reuses the grid's allocations.
     pub fn fill(&mut self, layout: CellLayout, count: usize, cells_of: impl Fn(usize) -> CellRange) {
         let (nx, cells) = (layout.nx, layout.nx * layout.ny);
-        let each_cell = |r: CellRange| (r.y0..=r.y1).flat_map(move |iy| (r.x0..=r.x1).map(move |ix| iy * nx + ix));
+        let each_cell = |r: CellRange| r.indices(nx);
         self.layout = layout;
         self.start.clear();
         self.start.resize(cells + 1, 0);
@@ -257,11 +263,18 @@ impl CellGrid {
     /// in each coordinate direction — a superset filter; the caller tests
     /// exactly. Nothing if that box lies wholly outside the grid.
     pub fn for_each_candidate(&self, x: &Vec2, reach: Real, f: impl FnMut(usize)) {
-        let lo = Vec2::new(x.x - reach, x.y - reach);
-        let hi = Vec2::new(x.x + reach, x.y + reach);
-        if let Some(range) = self.layout.cells_overlapping(&lo, &hi) {
+        if let Some(range) = self.cells_near(x, reach) {
             self.for_each_in(range, f);
         }
+    }
+
+    /// The cells [`Self::for_each_candidate`] visits for `x` and `reach`:
+    /// those the box `x ± reach` overlaps; none if it lies wholly outside
+    /// the grid.
+    pub fn cells_near(&self, x: &Vec2, reach: Real) -> Option<CellRange> {
+        let lo = Vec2::new(x.x - reach, x.y - reach);
+        let hi = Vec2::new(x.x + reach, x.y + reach);
+        self.layout.cells_overlapping(&lo, &hi)
     }
 }
 

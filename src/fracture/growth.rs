@@ -1094,9 +1094,8 @@ impl CrackGrowth {
     /// gate (`tip_min_triaxiality`) is not asked again: it decides where a
     /// tip may step, and a join steps into no material — the tip passed
     /// the gate when the crack stepped into it, as a propagation splits
-    /// the tip it leaves without asking. \[RL10\]'s
-    /// rules know the outer surface only: a tip that reaches another
-    /// crack's face finds every particle ahead a face of that crack or
+    /// the tip it leaves without asking. \[RL10\]'s rules know the outer
+    /// surface only: a tip that reaches another crack's face finds every particle ahead a face of that crack or
     /// behind it, so it neither advances nor arrests, and the ligament it
     /// leaves holds the plug, which is found between through-cracks only.
     /// Found on Case I's plate at 96 rows and 116.67 m/s: the ring crack

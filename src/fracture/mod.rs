@@ -583,8 +583,8 @@ pub struct FractureParameters {
     pub tip_direction: TipDirection,
     /// A growing tip steps only to a candidate whose stress triaxiality
     /// `σ_m/σ_eq` is at least this, dimensionless, in [−10, 0] (a join to
-    /// another crack steps into no material and does not ask it again). Default −1/3
-    /// ([`growth::NUCLEATION_MIN_TRIAXIALITY`], Bao and Wierzbicki's
+    /// another crack steps into no material and does not ask it again).
+    /// Default −1/3 ([`growth::NUCLEATION_MIN_TRIAXIALITY`], Bao and Wierzbicki's
     /// cut-off, the one nucleation keeps); −10 lifts it (module doc, "The
     /// compression gate").
     pub tip_min_triaxiality: Real,

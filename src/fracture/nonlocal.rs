@@ -148,21 +148,16 @@ impl NonlocalAverage {
     }
 
     /// The largest of `maxima` ([`Self::cell_maxima`]) over the cells the
-    /// ball about `x` reaches: every point [`Self::sums`] may count lies in
-    /// those cells, and an average of values with positive weights is at
-    /// most their largest, so no average of `f` about `x` exceeds it
-    /// (`−∞` where the ball reaches no cell).
+    /// ball about `x` reaches: [`Self::sums`] visits the points of those
+    /// cells only (the same [`CellGrid::cells_near`]), and an average of
+    /// values with positive weights is at most their largest, so no
+    /// average of `f` about `x` exceeds it (`−∞` where the ball reaches no
+    /// cell).
     pub fn upper_bound(&self, x: &Vec2, maxima: &[Real]) -> Real {
-        let layout = self.grid.layout();
-        let reach = Vec2::repeat(self.radius);
-        let Some(range) = layout.cells_overlapping(&(x - reach), &(x + reach)) else {
+        let Some(range) = self.grid.cells_near(x, self.radius) else {
             return Real::NEG_INFINITY;
         };
-        let nx = layout.dims().0;
-        (range.y0..=range.y1)
-            .flat_map(|iy| (range.x0..=range.x1).map(move |ix| iy * nx + ix))
-            .map(|c| maxima[c])
-            .fold(Real::NEG_INFINITY, Real::max)
+        range.indices(self.grid.layout().dims().0).map(|c| maxima[c]).fold(Real::NEG_INFINITY, Real::max)
     }
 
     /// The average `Σ α A f / Σ α A` (0 where no point counts).
