@@ -5,7 +5,7 @@
 
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use plugsim::material::johnson_cook::{JohnsonCook, RateForm};
-use plugsim::material::library::{weldox_460e, weldox_460e_borvik, weldox_460e_cutoff};
+use plugsim::material::library::{weldox_460e, weldox_460e_borvik, weldox_460e_borvik_coupled, weldox_460e_cutoff};
 use plugsim::material::{fractured, Constitutive, Elastic, Material, PointState, StepKinematics};
 use plugsim::material_point::{run, DriverConfig, LoadPath, Record};
 
@@ -38,7 +38,7 @@ impl Y {
 
 /// `ẏ` of the Johnson–Cook point: `ε̄̇ = φ(τ̄, g)`,
 /// `τ̇ = C:(d − ε̄̇ n̂) − 3Kα Ṫ I + wτ − τw`, `Ṫ = χ τ̄ ε̄̇/(ρ₀C_p)`,
-/// `Ḋ = ε̄̇/ε_f(σ*, ε̄̇, T*)`.
+/// `Ḋ = ε̄̇/ε_f(σ*, ε̄̇, T*)`; `g` scaled by Børvik's `(1 − D_C D)`.
 fn rhs(p: &JohnsonCook, y: &Y, d: &M3, w: &M3) -> Y {
     let shear = p.youngs_modulus / (2.0 * (1.0 + p.poisson_ratio));
     let bulk = p.youngs_modulus / (3.0 * (1.0 - 2.0 * p.poisson_ratio));
@@ -48,7 +48,8 @@ fn rhs(p: &JohnsonCook, y: &Y, d: &M3, w: &M3) -> Y {
     let tbar = (1.5 * s.dot(&s)).sqrt();
     let tstar = ((y.temp - p.room_temperature) / (p.melting_temperature - p.room_temperature)).clamp(0.0, 1.0);
     let g = (p.yield_stress + p.hardening_modulus * y.eps.powf(p.hardening_exponent))
-        * (1.0 - tstar.powf(p.softening_exponent));
+        * (1.0 - tstar.powf(p.softening_exponent))
+        * (1.0 - p.damage_coupling * y.dmg);
     let ratio = tbar / g;
     let c = p.rate_sensitivity;
     let rate = match p.rate_form {
@@ -195,6 +196,32 @@ fn uniaxial_strain_at_1e4_matches_reference_ode() {
 fn power_law_simple_shear_at_1e4_matches_reference_ode() {
     let worst = driver_vs_reference(&weldox_460e_borvik(), LoadPath::SimpleShear, 1e4, 1.0, 2000);
     assert_within(worst, 0.01, "power law, simple shear 1e4/s");
+}
+
+/// Børvik's coupled model (`D_C = 0.3`) through the peak of the adiabatic
+/// shear curve: at `γ = 3` the point has lost `0.3 D ≈ 20 %` of its flow
+/// stress to damage, and the reference ODE carries the factor itself.
+#[test]
+fn borvik_coupled_simple_shear_at_1e4_matches_reference_ode() {
+    let m = weldox_460e_borvik_coupled();
+    let worst = driver_vs_reference(&m, LoadPath::SimpleShear, 1e4, 3.0, 4000);
+    assert_within(worst, 0.01, "Borvik's coupled model, simple shear 1e4/s");
+    // The coupling is on: the uncoupled point ends at a higher stress.
+    let end = |m: &JohnsonCook| {
+        let config = DriverConfig {
+            path: LoadPath::SimpleShear,
+            rate: 1e4,
+            final_strain: 3.0,
+            dt: 3.0 / 1e4 / 4000.0,
+            initial_temperature: None,
+        };
+        let r = run(&Material::JohnsonCook(m.clone()), &config).unwrap();
+        let last = r.last().unwrap();
+        (von_mises(&last.tau), last.damage)
+    };
+    let (coupled, d) = end(&m);
+    let (free, _) = end(&weldox_460e_borvik());
+    assert!(d > 0.5 && coupled < 0.9 * free, "D {d}, coupled {coupled:.4e} against {free:.4e}");
 }
 
 /// Observed order: the damage of the tangent update is first order in the

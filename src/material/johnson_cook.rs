@@ -104,8 +104,10 @@
 //!     `tests/material.rs::simple_shear_at_1e7_with_the_paper_step_is_smooth`,
 //!     `tests/material.rs::adiabatic_softening_runs_up_to_melting`.
 //!
-//! The damage factor `(1 − D)` (when `damage_coupling` is on) is clamped to
-//! `[0, 1]` and held fixed over a step (not linearised in `H`). `D` itself is
+//! The damage factor `(1 − D_C D)` (Børvik's coupling, `damage_coupling` =
+//! `D_C`; SPEC §6 writes the switch `damage_coupling = true`, which reads as
+//! `D_C = 1`, the plain `(1 − D)`) is clamped to `[0, 1]` and held fixed
+//! over a step (not linearised in `H`). `D` itself is
 //! not capped at 1: `D ≥ 1` means failed. The heating and the thermal
 //! expansion term use the start-of-step `τ̄`, as SPEC §6 writes (except in
 //! the fallback of Deviation 5).
@@ -268,10 +270,16 @@ pub struct JohnsonCook {
     pub conductivity: Real,
     /// Johnson–Cook damage constants.
     pub damage: DamageConstants,
-    /// Scale the flow stress by `(1 − D)` (Børvik's coupled model). Default
-    /// off, as in \[RL10\], where cracks, not softening, carry the failure.
-    #[serde(default = "default_false")]
-    pub damage_coupling: bool,
+    /// Børvik's critical damage `D_C` in [0, 1]: the flow stress is scaled
+    /// by `(1 − D_C D)`, `D` the Johnson–Cook damage (fracture at `D = 1`).
+    /// Børvik et al.'s damage variable is `D_C D`, which grows at
+    /// `D_C/ε_f` per unit plastic strain and reaches `D_C` as the locus is
+    /// used up, so their Weldox 460 E (`D_C = 0.3`) loses 30 % of its flow
+    /// stress at fracture. `1` is the plain `(1 − D)`; `0` (the default)
+    /// uncouples, as in \[RL10\], where cracks, not softening, carry the
+    /// failure. A case file may also write `true` / `false` for 1 / 0.
+    #[serde(default, deserialize_with = "coupling_from_case")]
+    pub damage_coupling: Real,
     /// Tangent-method parameter `θ` in [0, 1]; see [`JohnsonCook::DEFAULT_THETA`].
     #[serde(default = "default_theta")]
     pub theta: Real,
@@ -335,8 +343,19 @@ pub struct ParameterError {
 fn default_taylor_quinney() -> Real {
     0.9
 }
-fn default_false() -> bool {
-    false
+/// `damage_coupling` from a case file: a number (`D_C`), or `true` /
+/// `false` for 1 / 0 (the switch of the plain `(1 − D)` it was before).
+fn coupling_from_case<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<Real, D::Error> {
+    #[derive(serde::Deserialize)]
+    #[serde(untagged)]
+    enum Coupling {
+        Switch(bool),
+        Critical(Real),
+    }
+    Ok(match <Coupling as serde::Deserialize>::deserialize(deserializer)? {
+        Coupling::Switch(on) => Real::from(u8::from(on)),
+        Coupling::Critical(d_c) => d_c,
+    })
 }
 fn default_theta() -> Real {
     JohnsonCook::DEFAULT_THETA
@@ -395,6 +414,8 @@ impl JohnsonCook {
         if let Some(c) = dc.cutoff_triaxiality {
             check("damage.cutoff_triaxiality", c, c <= 0.0, "<= 0 (no damage below it)");
         }
+        let d_c = self.damage_coupling;
+        check("damage_coupling", d_c, (0.0..=1.0).contains(&d_c), "in [0, 1] (Børvik's critical damage D_C)");
         check("theta", self.theta, (0.0..=1.0).contains(&self.theta), "in [0, 1]");
         if errors.is_empty() {
             Ok(())
@@ -427,11 +448,11 @@ impl JohnsonCook {
         }
     }
 
-    /// The damage factor `(1 − D)` clamped to [0, 1] when `damage_coupling`
-    /// is on, else 1.
+    /// The damage factor `(1 − D_C D)` clamped to [0, 1] (`D_C` the
+    /// [`JohnsonCook::damage_coupling`]; 1 when uncoupled).
     pub fn damage_factor(&self, damage: Real) -> Real {
-        if self.damage_coupling {
-            (1.0 - damage).clamp(0.0, 1.0)
+        if self.damage_coupling > 0.0 {
+            (1.0 - self.damage_coupling * damage).clamp(0.0, 1.0)
         } else {
             1.0
         }
@@ -1049,7 +1070,7 @@ mod tests {
     #[test]
     fn softening_slope_matches_finite_differences() {
         let mut m = weldox_460e();
-        for damage_coupling in [false, true] {
+        for damage_coupling in [0.0, 0.3, 1.0] {
             m.damage_coupling = damage_coupling;
             for t_star in [0.01, 0.2, 0.5, 0.9, 0.99] {
                 let t = m.room_temperature + t_star * (m.melting_temperature - m.room_temperature);
@@ -1485,13 +1506,39 @@ mod tests {
         let mut m = weldox_460e();
         let g0 = m.flow_stress(0.2, 500.0, 0.0);
         assert_eq!(m.flow_stress(0.2, 500.0, 0.4), g0);
-        m.damage_coupling = true;
+        m.damage_coupling = 1.0;
         assert!(rel(m.flow_stress(0.2, 500.0, 0.4), 0.6 * g0) < 1e-14);
         assert_eq!(m.flow_stress(0.2, 500.0, 1.3), 0.0);
         // A fully damaged coupled point carries no deviatoric stress.
         let old = PointState { damage: 1.0, ..state(uniaxial(g0), 0.2, 500.0) };
         let new = m.update(&old, &kin(diag(1e3, 0.0, 0.0), Tensor3::zeros(), 1e-7));
         assert_eq!(von_mises(&new.tau), 0.0);
+        // Børvik's D_C = 0.3: 30 % of the flow stress gone when the locus is
+        // used up (D = 1), 12 % at D = 0.4, and never more than 100 %.
+        m.damage_coupling = 0.3;
+        assert!(rel(m.flow_stress(0.2, 500.0, 0.4), 0.88 * g0) < 1e-14);
+        assert!(rel(m.flow_stress(0.2, 500.0, 1.0), 0.7 * g0) < 1e-14);
+        assert_eq!(m.flow_stress(0.2, 500.0, 4.0), 0.0);
+    }
+
+    #[test]
+    fn damage_coupling_reads_a_critical_damage_or_the_old_switch() {
+        let read = |value: &str| -> Result<Real, String> {
+            let mut table: toml::Table = toml::to_string(&weldox_460e()).unwrap().parse().unwrap();
+            table.remove("damage_coupling");
+            // Before the table's sub-tables, so that it stays a top-level key.
+            let text = format!("damage_coupling = {value}\n{}", toml::to_string(&table).unwrap());
+            let m: JohnsonCook = toml::from_str(&text).map_err(|e| e.to_string())?;
+            m.validate().map_err(|e| format!("{e:?}"))?;
+            Ok(m.damage_coupling)
+        };
+        assert_eq!(read("0.3"), Ok(0.3));
+        assert_eq!(read("1"), Ok(1.0));
+        assert_eq!(read("true"), Ok(1.0));
+        assert_eq!(read("false"), Ok(0.0));
+        let err = read("1.5").unwrap_err();
+        assert!(err.contains("damage_coupling"), "{err}");
+        assert!(read("\"yes\"").is_err());
     }
 
     #[test]

@@ -11,14 +11,22 @@ use super::johnson_cook::{DamageConstants, JohnsonCook, RateForm};
 use super::Material;
 
 /// Names accepted by [`builtin`], in a stable order.
-pub const NAMES: &[&str] =
-    &["weldox_460e", "weldox_460e_borvik", "weldox_460e_cutoff", "ofhc_copper", "steel_4340", "steel_42crmo4"];
+pub const NAMES: &[&str] = &[
+    "weldox_460e",
+    "weldox_460e_borvik",
+    "weldox_460e_borvik_coupled",
+    "weldox_460e_cutoff",
+    "ofhc_copper",
+    "steel_4340",
+    "steel_42crmo4",
+];
 
 /// The built-in material called `name`, or `None`.
 pub fn builtin(name: &str) -> Option<Material> {
     match name {
         "weldox_460e" => Some(Material::JohnsonCook(weldox_460e())),
         "weldox_460e_borvik" => Some(Material::JohnsonCook(weldox_460e_borvik())),
+        "weldox_460e_borvik_coupled" => Some(Material::JohnsonCook(weldox_460e_borvik_coupled())),
         "weldox_460e_cutoff" => Some(Material::JohnsonCook(weldox_460e_cutoff())),
         "ofhc_copper" => Some(Material::JohnsonCook(ofhc_copper())),
         "steel_4340" => Some(Material::JohnsonCook(steel_4340())),
@@ -55,7 +63,7 @@ pub fn weldox_460e() -> JohnsonCook {
         thermal_expansion: 11.2e-6,
         conductivity: 50.0,
         damage: DamageConstants { d1: 0.0705, d2: 1.732, d3: -0.54, d4: -0.015, d5: 0.0, cutoff_triaxiality: None },
-        damage_coupling: false,
+        damage_coupling: 0.0,
         theta: JohnsonCook::DEFAULT_THETA,
     }
 }
@@ -66,11 +74,10 @@ pub fn weldox_460e() -> JohnsonCook {
 ///
 /// Source: the `[material.weldox_460e.borvik_modified]` table of the
 /// reference file (Børvik et al.'s fit of this steel, quoted alongside
-/// \[RL10\] Table 2). Børvik's coupled damage model would also scale the flow
-/// stress by `(1 − D)` and fracture at `D = 0.3`; this set keeps
-/// `damage_coupling` off, so that comparing it with [`weldox_460e`] isolates
-/// the rate law (SPEC §6: "the validation report shows both"). Switch it on
-/// for the coupled model.
+/// \[RL10\] Table 2). This set keeps `damage_coupling` off, so that
+/// comparing it with [`weldox_460e`] isolates the rate law (SPEC §6: "the
+/// validation report shows both"); [`weldox_460e_borvik_coupled`] is their
+/// coupled model.
 pub fn weldox_460e_borvik() -> JohnsonCook {
     JohnsonCook {
         poisson_ratio: 0.33,
@@ -79,6 +86,26 @@ pub fn weldox_460e_borvik() -> JohnsonCook {
         thermal_expansion: 1.1e-5,
         ..weldox_460e()
     }
+}
+
+/// Børvik et al.'s coupled model of Weldox 460 E: [`weldox_460e_borvik`]
+/// with the flow stress scaled by `(1 − D_C D)`, `D_C = 0.3`.
+///
+/// Source: `critical_damage_coupled = 0.3` of the reference file's
+/// `[material.weldox_460e.borvik_modified]` table. How it enters is read
+/// from Børvik, Hopperstad, Berstad & Langseth's model (Eur. J. Mech.
+/// A/Solids 20 (2001) 685–712; quoted from memory, the paper is not in the
+/// stored literature): their damage grows at `D_C/ε_f` per unit plastic
+/// strain from a threshold `p_d = 0` for this steel and fracture comes when
+/// it reaches `D_C`, that is when the Johnson–Cook damage `D` of this crate
+/// (`∫ dε̄/ε_f`) reaches 1 — the locus as it stands, with 30 % of the flow
+/// stress lost by then. Two differences from their model, both small at
+/// `D_C D ≤ 0.3`: they integrate hardening and damage over the
+/// damage-equivalent strain `∫ (1 − D_C D) dε̄`, this crate over `ε̄`; and
+/// the fracture criterion is the case's (`critical_damage = 1` of the
+/// per-particle damage criterion is theirs: an element erodes at `D_C`).
+pub fn weldox_460e_borvik_coupled() -> JohnsonCook {
+    JohnsonCook { damage_coupling: 0.3, ..weldox_460e_borvik() }
 }
 
 /// Weldox 460 E as [`weldox_460e`], with the damage locus cut off below
@@ -136,7 +163,7 @@ pub fn ofhc_copper() -> JohnsonCook {
         thermal_expansion: 0.0,
         conductivity: 0.0,
         damage: NO_DAMAGE,
-        damage_coupling: false,
+        damage_coupling: 0.0,
         theta: JohnsonCook::DEFAULT_THETA,
     }
 }
