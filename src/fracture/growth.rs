@@ -1095,9 +1095,10 @@ impl CrackGrowth {
     /// tip may step, and a join steps into no material — the tip passed
     /// the gate when the crack stepped into it, as a propagation splits
     /// the tip it leaves without asking. \[RL10\]'s rules know the outer
-    /// surface only: a tip that reaches another crack's face finds every particle ahead a face of that crack or
-    /// behind it, so it neither advances nor arrests, and the ligament it
-    /// leaves holds the plug, which is found between through-cracks only.
+    /// surface only: a tip that reaches another crack's face finds every
+    /// particle ahead a face of that crack or behind it, so it neither
+    /// advances nor arrests, and the ligament it leaves holds the plug,
+    /// which is found between through-cracks only.
     /// Found on Case I's plate at 96 rows and 116.67 m/s: the ring crack
     /// from the corner stopped one spacing above a second crack from the
     /// bottom face while the plug moved away at 41 m/s (docs/validation.md,

@@ -584,16 +584,15 @@ pub struct FractureParameters {
     /// A growing tip steps only to a candidate whose stress triaxiality
     /// `σ_m/σ_eq` is at least this, dimensionless, in [−10, 0] (a join to
     /// another crack steps into no material and does not ask it again).
-    /// Default −1/3 ([`growth::NUCLEATION_MIN_TRIAXIALITY`], Bao and Wierzbicki's
-    /// cut-off, the one nucleation keeps); −10 lifts it (module doc, "The
-    /// compression gate").
+    /// Default −1/3 ([`growth::NUCLEATION_MIN_TRIAXIALITY`], Bao and
+    /// Wierzbicki's cut-off, the one nucleation keeps); −10 lifts it
+    /// (module doc, "The compression gate").
     pub tip_min_triaxiality: Real,
     /// Whether the tip's gate (`tip_min_triaxiality`) on its candidates
     /// reads the triaxiality averaged over `nonlocal_radius` (the ratio of
     /// the averaged mean and von Mises stresses, the ball and weights of
     /// the damage average) instead of the candidate particle's own.
-    /// Default false
-    /// (module doc, "The compression gate on the tip").
+    /// Default false (module doc, "The compression gate on the tip").
     pub nonlocal_tip_triaxiality: bool,
 }
 
