@@ -202,7 +202,7 @@ impl BoundScratch {
 fn point_modulus(material: &Material, eroded: bool, fractured: Option<(Real, Real)>) -> Real {
     match (eroded, fractured) {
         (true, _) => 0.0,
-        (false, Some((damage, j))) if damage >= 1.0 => {
+        (false, Some((damage, j))) if crate::material::is_fractured(damage) => {
             if j < 1.0 {
                 material.bulk_modulus()
             } else {

@@ -600,7 +600,7 @@ impl Simulation {
                 }
                 _ => return Some((qi, J)),
             };
-            if fracturing && c.damage[k] >= 1.0 && J >= crate::material::TORN_VOLUME_RATIO {
+            if fracturing && crate::material::is_fractured(c.damage[k]) && J >= crate::material::TORN_VOLUME_RATIO {
                 // Torn open (`crate::material::TORN_VOLUME_RATIO`): eroded.
                 c.eroded[k] = true;
                 c.tau[k] = Block2::zeros();
@@ -634,7 +634,7 @@ impl Simulation {
                 c.damping = c.damping.max(viscosity.damping_ratio(wave_speed, length, rate));
                 let q = viscosity.pressure(mat.density() / J, wave_speed, length, rate);
                 // A fractured point carries no tension (`material::fractured`), viscous or not.
-                let q = if fracturing && new.damage >= 1.0 { q.max(0.0) } else { q };
+                let q = if fracturing && crate::material::is_fractured(new.damage) { q.max(0.0) } else { q };
                 force_tau = new_tau.sub(&Block2::identity_scaled(J * q));
                 c.work[k] -= J * q * rate * dt * w;
             }

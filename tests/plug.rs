@@ -158,3 +158,96 @@ fn the_tracker_follows_velocity_and_recomputes_when_the_cracks_change() {
     assert_eq!(t.first_cut, Some(2e-6), "the first cut stays");
     assert!((second.velocity() - Vec2::new(0.0, -50.0)).norm() < 1e-9);
 }
+
+/// Break every quadrature point of the background cells between lattice
+/// columns `i` and `i + 1` whose centre lies below `y_top`: erode it, or
+/// (with `fracture`) set its damage to 1, fractured by the damage model's
+/// own measure.
+fn break_band(m: &mut Model, i: usize, y_top: Real, fracture: bool) {
+    let q = &mut m.quad;
+    for k in 0..q.len() {
+        let x = q.x0[k];
+        if x.x > i as Real * H && x.x < (i + 1) as Real * H && x.y < y_top {
+            if fracture {
+                q.damage[k] = 1.0;
+            } else {
+                q.eroded[k] = true;
+            }
+        }
+    }
+}
+
+#[test]
+fn a_band_of_broken_points_cuts_out_a_plug_without_cracks() {
+    // Two bands of eroded points through the thickness, no crack at all:
+    // the particles between them are the plug, as with two through-cracks.
+    let mut m = plate(GeometryMode::PlaneStrain);
+    let g = growth();
+    break_band(&mut m, 8, Real::INFINITY, false);
+    assert_eq!(plug_particles(&m, &g, 12.0 * H), None, "one band: the plug still hangs on the other side");
+    break_band(&mut m, 15, Real::INFINITY, false);
+    assert_eq!(plug_particles(&m, &g, 12.0 * H).expect("a plug"), between(&m, 8, 16));
+    // Fractured points (D = 1) break bonds only where the solver fractures
+    // points: the per-particle criteria, and the default non-local one
+    // unless its point fracture is off.
+    let cases = [(Criterion::Damage, true, true), (Criterion::NonlocalDamage, true, true)];
+    let cases = cases.into_iter().chain([(Criterion::NonlocalDamage, false, false), (Criterion::None, true, false)]);
+    for (criterion, nonlocal_point_fracture, cuts) in cases {
+        let mut m = plate(GeometryMode::PlaneStrain);
+        break_band(&mut m, 8, Real::INFINITY, true);
+        break_band(&mut m, 15, Real::INFINITY, true);
+        let params = FractureParameters { criterion, nonlocal_point_fracture, ..FractureParameters::default() };
+        let g = CrackGrowth::new(params);
+        let plug = plug_particles(&m, &g, 12.0 * H);
+        assert_eq!(plug.is_some(), cuts, "{criterion:?}");
+        if cuts {
+            assert_eq!(plug.unwrap(), between(&m, 8, 16));
+        }
+    }
+    // A ring band in axisymmetry, and a band that meets a crack still
+    // growing (its tip's cells broken on both sides): the axis region
+    // inside the ring is the plug.
+    let mut m = plate(GeometryMode::Axisymmetric);
+    break_band(&mut m, 8, Real::INFINITY, false);
+    let inside: Vec<usize> = (0..m.particles.len()).filter(|&k| m.particles.x0[k].x < 8.5 * H).collect();
+    assert_eq!(plug_particles(&m, &g, 0.0).expect("a ring of eroded points"), inside);
+    let mut m = plate(GeometryMode::Axisymmetric);
+    let mut g = growth();
+    cut(&mut m, &mut g, 8, 4);
+    break_band(&mut m, 7, 4.5 * H, false);
+    break_band(&mut m, 8, 4.5 * H, false);
+    let plug = plug_particles(&m, &g, 0.0).expect("a crack from the top, broken points below it");
+    assert!(plug.iter().all(|&k| m.particles.x0[k].x < 8.5 * H));
+    assert!(plug.len() >= 8 * NY, "{} particles", plug.len());
+}
+
+#[test]
+fn one_point_still_carrying_tension_holds_the_plug() {
+    let mut m = plate(GeometryMode::PlaneStrain);
+    let g = growth();
+    break_band(&mut m, 8, Real::INFINITY, false);
+    break_band(&mut m, 15, Real::INFINITY, false);
+    let mut t = PlugTracker::default();
+    // Keep one point of one band's cells intact, mid-thickness.
+    let q = &mut m.quad;
+    let keep = (0..q.len())
+        .filter(|&k| q.eroded[k])
+        .min_by(|&a, &b| {
+            let d = |k: usize| (q.x0[k] - Vec2::new(8.5 * H, 3.5 * H)).norm();
+            d(a).partial_cmp(&d(b)).unwrap()
+        })
+        .unwrap();
+    q.eroded[keep] = false;
+    assert_eq!(t.update(&m, &g, 12.0 * H, 1e-6), None, "one unbroken point bonds its cell's links");
+    assert_eq!(t.first_cut, None);
+    // The tracker fills again when the broken points change.
+    m.quad.eroded[keep] = true;
+    let plug = t.update(&m, &g, 12.0 * H, 2e-6).expect("the last point broken");
+    assert_eq!(plug.particles, between(&m, 8, 16));
+    assert_eq!(t.first_cut, Some(2e-6));
+    // A band that stops a row short of the far face cuts nothing out.
+    let mut m = plate(GeometryMode::PlaneStrain);
+    break_band(&mut m, 8, Real::INFINITY, false);
+    break_band(&mut m, 15, (NY as Real - 2.0) * H, false);
+    assert_eq!(plug_particles(&m, &g, 12.0 * H), None);
+}

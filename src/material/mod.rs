@@ -75,6 +75,14 @@ pub trait Constitutive {
     }
 }
 
+/// Whether a point with Johnson–Cook damage `damage` is fractured by the
+/// damage model's own measure (`D ≥ 1`): while cracks grow, such a point
+/// carries only pressure, and only while closed ([`fractured`]).
+#[inline]
+pub fn is_fractured(damage: Real) -> bool {
+    damage >= 1.0
+}
+
 /// A point whose Johnson–Cook damage has reached 1 — fractured by the
 /// damage model's own measure — carries no shear and no tension, and
 /// carries pressure only while it is **closed**: its Kirchhoff stress is
@@ -117,7 +125,7 @@ pub trait Constitutive {
 ///   tests/ejection.rs).
 #[inline]
 pub fn fractured(mut s: PointState, jacobian: Real) -> PointState {
-    if s.damage >= 1.0 {
+    if is_fractured(s.damage) {
         let mean = if jacobian < 1.0 { s.tau.trace() / 3.0 } else { 0.0 };
         s.tau = Tensor3::identity() * mean.min(0.0);
     }
