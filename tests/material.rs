@@ -38,7 +38,9 @@ impl Y {
 
 /// `ẏ` of the Johnson–Cook point: `ε̄̇ = φ(τ̄, g)`,
 /// `τ̇ = C:(d − ε̄̇ n̂) − 3Kα Ṫ I + wτ − τw`, `Ṫ = χ τ̄ ε̄̇/(ρ₀C_p)`,
-/// `Ḋ = ε̄̇/ε_f(σ*, ε̄̇, T*)`; `g` scaled by Børvik's `(1 − D_C D)`.
+/// `Ḋ = ε̄̇/ε_f(σ*, ε̄̇, T*)`; `g` scaled by Børvik's `(1 − D_C D)`, and
+/// with his damage-equivalent strain `eps` is `r` and `ṙ = (1 − D_C D) ε̄̇`
+/// drives the hardening and `Ḋ = ṙ/ε_f`.
 fn rhs(p: &JohnsonCook, y: &Y, d: &M3, w: &M3) -> Y {
     let shear = p.youngs_modulus / (2.0 * (1.0 + p.poisson_ratio));
     let bulk = p.youngs_modulus / (3.0 * (1.0 - 2.0 * p.poisson_ratio));
@@ -70,13 +72,16 @@ fn rhs(p: &JohnsonCook, y: &Y, d: &M3, w: &M3) -> Y {
         RateForm::Log => 1.0 + dc.d4 * rstar.max(1.0).ln(),
         RateForm::Power => (1.0 + rstar).powf(dc.d4),
     };
+    // Børvik's damage-equivalent strain: hardening and damage over
+    // `dr = (1 − D_C D) dε̄`.
+    let r_rate = if p.damage_equivalent_strain { rate * (1.0 - p.damage_coupling * y.dmg) } else { rate };
     let dmg = if tbar > 0.0 {
         let eps_f = (dc.d1 + dc.d2 * (dc.d3 * mean / tbar).exp()) * rate_term * (1.0 + dc.d5 * tstar);
-        rate / eps_f
+        r_rate / eps_f
     } else {
         0.0
     };
-    Y { tau: taudot, eps: rate, temp: tdot, dmg }
+    Y { tau: taudot, eps: r_rate, temp: tdot, dmg }
 }
 
 /// RK4 over `[0, t_end]` in `n` steps; returns the states at `t_end·i/marks`,
@@ -200,12 +205,17 @@ fn power_law_simple_shear_at_1e4_matches_reference_ode() {
 
 /// Børvik's coupled model (`D_C = 0.3`) through the peak of the adiabatic
 /// shear curve: at `γ = 3` the point has lost `0.3 D ≈ 20 %` of its flow
-/// stress to damage, and the reference ODE carries the factor itself.
+/// stress to damage, and the reference ODE carries the factor itself; with
+/// the damage-equivalent strain `r` (the built-in set) and over `ε̄`.
 #[test]
 fn borvik_coupled_simple_shear_at_1e4_matches_reference_ode() {
     let m = weldox_460e_borvik_coupled();
-    let worst = driver_vs_reference(&m, LoadPath::SimpleShear, 1e4, 3.0, 4000);
-    assert_within(worst, 0.01, "Borvik's coupled model, simple shear 1e4/s");
+    assert!(m.damage_equivalent_strain);
+    let over_eps = JohnsonCook { damage_equivalent_strain: false, ..m.clone() };
+    for (m, name) in [(&m, "over r"), (&over_eps, "over eps")] {
+        let worst = driver_vs_reference(m, LoadPath::SimpleShear, 1e4, 3.0, 4000);
+        assert_within(worst, 0.01, &format!("Borvik's coupled model {name}, simple shear 1e4/s"));
+    }
     // The coupling is on: the uncoupled point ends at a higher stress.
     let end = |m: &JohnsonCook| {
         let config = DriverConfig {
@@ -217,11 +227,16 @@ fn borvik_coupled_simple_shear_at_1e4_matches_reference_ode() {
         };
         let r = run(&Material::JohnsonCook(m.clone()), &config).unwrap();
         let last = r.last().unwrap();
-        (von_mises(&last.tau), last.damage)
+        (von_mises(&last.tau), last.damage, last.eps_p)
     };
-    let (coupled, d) = end(&m);
-    let (free, _) = end(&weldox_460e_borvik());
+    let (coupled, d, r) = end(&m);
+    let (free, _, _) = end(&weldox_460e_borvik());
     assert!(d > 0.5 && coupled < 0.9 * free, "D {d}, coupled {coupled:.4e} against {free:.4e}");
+    // `r` grows at (1 − 0.3 D) of `ε̄`: behind it by 10–20 % at D ≈ 0.6,
+    // and so is the damage.
+    let (_, d_eps, eps) = end(&over_eps);
+    assert!(r < 0.92 * eps && r > 0.75 * eps, "r {r} against eps {eps}");
+    assert!(d < 0.92 * d_eps && d > 0.75 * d_eps, "D {d} over r against {d_eps} over eps");
 }
 
 /// Observed order: the damage of the tangent update is first order in the

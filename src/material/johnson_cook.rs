@@ -108,7 +108,17 @@
 //! `D_C`; SPEC §6 writes the switch `damage_coupling = true`, which reads as
 //! `D_C = 1`, the plain `(1 − D)`) is clamped to `[0, 1]` and held fixed
 //! over a step (not linearised in `H`). `D` itself is
-//! not capped at 1: `D ≥ 1` means failed. The heating and the thermal
+//! not capped at 1: `D ≥ 1` means failed. With Børvik's damage-equivalent
+//! strain (`damage_equivalent_strain`; Børvik, Hopperstad, Berstad &
+//! Langseth 2001, as recalled in `docs/validation.md`) hardening and
+//! damage run on `r`, `dr = (1 − D_C D) dε̄`: `eps_p` holds `r`, each
+//! step's increments of `r` and `D` are those over `ε̄` times the factor
+//! at the start of the step, the radial return hardens over `r`, and
+//! `g_ε` is per unit of `ε̄` (`∂g/∂r (1 − D_C D)`, which enters `H`); the
+//! rate law and the heating stay on `ε̄̇`. Deviation from SPEC §6, which
+//! knows `ε̄` only; off by default, the same bits then. Test:
+//! `tests/material.rs::borvik_coupled_simple_shear_at_1e4_matches_reference_ode`
+//! (the reference ODE integrates `r`). The heating and the thermal
 //! expansion term use the start-of-step `τ̄`, as SPEC §6 writes (except in
 //! the fallback of Deviation 5).
 //! 12. **Negligible flow.** Before any flow update, the viscoplastic rate
@@ -280,6 +290,13 @@ pub struct JohnsonCook {
     /// failure. A case file may also write `true` / `false` for 1 / 0.
     #[serde(default, deserialize_with = "coupling_from_case")]
     pub damage_coupling: Real,
+    /// Børvik et al.'s damage-equivalent plastic strain `r`, with
+    /// `dr = (1 − D_C D) dε̄`: hardening and damage accumulate over `r`
+    /// instead of `ε̄` (`g = (A + B rⁿ)…(1 − D_C D)`, `dD = dr/ε_f`), and
+    /// the point's `eps_p` holds `r` (module doc, "The damage factor").
+    /// Needs `damage_coupling > 0`. Default false.
+    #[serde(default)]
+    pub damage_equivalent_strain: bool,
     /// Tangent-method parameter `θ` in [0, 1]; see [`JohnsonCook::DEFAULT_THETA`].
     #[serde(default = "default_theta")]
     pub theta: Real,
@@ -416,6 +433,13 @@ impl JohnsonCook {
         }
         let d_c = self.damage_coupling;
         check("damage_coupling", d_c, (0.0..=1.0).contains(&d_c), "in [0, 1] (Børvik's critical damage D_C)");
+        let with_coupling = !self.damage_equivalent_strain || d_c > 0.0;
+        check(
+            "damage_equivalent_strain",
+            d_c,
+            with_coupling,
+            "false while damage_coupling is 0 (the value shown is damage_coupling)",
+        );
         check("theta", self.theta, (0.0..=1.0).contains(&self.theta), "in [0, 1]");
         if errors.is_empty() {
             Ok(())
@@ -458,6 +482,18 @@ impl JohnsonCook {
         }
     }
 
+    /// `dr/dε̄` of the hardening and damage variable at damage factor
+    /// `dmg` ([`JohnsonCook::damage_factor`]): `dmg` with Børvik's
+    /// damage-equivalent strain ([`JohnsonCook::damage_equivalent_strain`]),
+    /// else 1 (the variable is `ε̄`).
+    pub fn strain_scale(&self, dmg: Real) -> Real {
+        if self.damage_equivalent_strain {
+            dmg
+        } else {
+            1.0
+        }
+    }
+
     /// Johnson–Cook flow stress at the reference rate,
     /// `g = (A + B ε̄ⁿ)(1 − T*ᵐ)` (× `(1 − D)` with damage coupling), Pa.
     /// SPEC §6, [RL10, Eqs. (2.46)–(2.72)].
@@ -490,13 +526,15 @@ impl JohnsonCook {
         FlowFactors { eps, eps_n, strain_part: self.yield_stress + self.hardening_modulus * eps_n, thermal, dmg }
     }
 
-    /// `g_ε = B n ε̄ⁿ⁻¹ (1 − T*ᵐ)(1 − D)`, regularised by Deviation 1.
+    /// `g_ε = B n ε̄ⁿ⁻¹ (1 − T*ᵐ)(1 − D)`, regularised by Deviation 1; per
+    /// unit of `ε̄` also with Børvik's damage-equivalent strain `r` (there
+    /// `∂g/∂r · dr/dε̄`, [`JohnsonCook::strain_scale`]).
     fn hardening_slope(&self, f: &FlowFactors) -> Real {
         let n = self.hardening_exponent;
         // ε̄ⁿ⁻¹ = ε̄ⁿ/ε̄ above the floor: one power instead of two.
         let eps_n_minus_1 =
             if f.eps >= PLASTIC_STRAIN_FLOOR { f.eps_n / f.eps } else { PLASTIC_STRAIN_FLOOR.powf(n - 1.0) };
-        self.hardening_modulus * n * eps_n_minus_1 * f.thermal * f.dmg
+        self.hardening_modulus * n * eps_n_minus_1 * f.thermal * f.dmg * self.strain_scale(f.dmg)
     }
 
     /// [`JohnsonCook::flow_stress_slopes`] from the factors at `temperature`.
@@ -894,7 +932,7 @@ impl JohnsonCook {
         let (thermal, dmg) = (self.thermal_factor(old.temperature), self.damage_factor(old.damage));
         let residual = |tau_e: Real| {
             let d_eps = (tau_trial - tau_e) / three_g;
-            let f = self.hardening_factors(old.eps_p + d_eps, thermal, dmg);
+            let f = self.hardening_factors(old.eps_p + self.strain_scale(dmg) * d_eps, thermal, dmg);
             let g = f.g().max(fs.g);
             let pr = self.plastic_rate(tau_e, g);
             let r = dt * pr.rate - d_eps;
@@ -947,14 +985,12 @@ impl JohnsonCook {
             damage: old.damage + d_eps / self.failure_strain(triaxiality, rate, old.temperature),
         }
     }
-}
 
-impl Constitutive for JohnsonCook {
-    /// One step of SPEC §6: strengthless points (Deviation 4), the power
-    /// law's elastic branch (Deviation 8), the radial return where the flow
-    /// direction is not resolved (Deviation 11), else the tangent-modulus
-    /// update.
-    fn update(&self, old: &PointState, k: &StepKinematics) -> PointState {
+    /// One step of SPEC §6 over the plastic strain `ε̄` (module doc):
+    /// strengthless points (Deviation 4), the power law's elastic branch
+    /// (Deviation 8), the radial return where the flow direction is not
+    /// resolved (Deviation 11), else the tangent-modulus update.
+    fn update_over_plastic_strain(&self, old: &PointState, k: &StepKinematics) -> PointState {
         let mut log_trial = None;
         if self.rate_form == RateForm::Log && k.dt > 0.0 {
             let (t, tau_trial) = self.elastic_trial(&old.tau, k);
@@ -981,6 +1017,27 @@ impl Constitutive for JohnsonCook {
         }
         let pr = self.plastic_rate(tau_bar, fs.g);
         self.flow_step(old, &k.d, &k.w, k.dt, &fs, &pr)
+    }
+}
+
+impl Constitutive for JohnsonCook {
+    /// One step of SPEC §6 (`JohnsonCook::update_over_plastic_strain`),
+    /// over Børvik's damage-equivalent strain where the material asks.
+    fn update(&self, old: &PointState, k: &StepKinematics) -> PointState {
+        let new = self.update_over_plastic_strain(old, k);
+        if !self.damage_equivalent_strain {
+            return new;
+        }
+        // Børvik's damage-equivalent strain: the step's increments of the
+        // hardening variable and of the damage scale by `dr/dε̄ = 1 − D_C D`
+        // at the start of the step (the radial return's hardening and every
+        // `g_ε` already use it); `eps_p_rate` stays `ε̄̇`.
+        let scale = self.strain_scale(self.damage_factor(old.damage));
+        PointState {
+            eps_p: old.eps_p + scale * (new.eps_p - old.eps_p),
+            damage: old.damage + scale * (new.damage - old.damage),
+            ..new
+        }
     }
     fn density(&self) -> Real {
         self.density
@@ -1539,6 +1596,30 @@ mod tests {
         let err = read("1.5").unwrap_err();
         assert!(err.contains("damage_coupling"), "{err}");
         assert!(read("\"yes\"").is_err());
+        // The damage-equivalent strain asks for a coupling.
+        let m = JohnsonCook { damage_equivalent_strain: true, ..weldox_460e() };
+        let err = format!("{:?}", m.validate().unwrap_err());
+        assert!(err.contains("damage_equivalent_strain"), "{err}");
+        assert!(JohnsonCook { damage_coupling: 0.3, ..m }.validate().is_ok());
+    }
+
+    #[test]
+    fn damage_equivalent_strain_scales_the_increments_of_hardening_and_damage() {
+        // One plastic step from a damaged state: over r, the increments of
+        // eps_p and D are those over eps times (1 − D_C D), the stress the
+        // same to the hardening's change.
+        let base = JohnsonCook { damage_coupling: 0.3, ..weldox_460e() };
+        let over_r = JohnsonCook { damage_equivalent_strain: true, ..base.clone() };
+        let g = base.flow_stress(0.2, 500.0, 0.5);
+        let old = PointState { damage: 0.5, ..state(uniaxial(g), 0.2, 500.0) };
+        let k = kin(diag(1e4, -5e3, -5e3), Tensor3::zeros(), 1e-8);
+        let (a, b) = (base.update(&old, &k), over_r.update(&old, &k));
+        let factor = 1.0 - 0.3 * 0.5;
+        assert!(a.eps_p > old.eps_p && a.damage > old.damage);
+        assert!(rel(b.eps_p - old.eps_p, factor * (a.eps_p - old.eps_p)) < 1e-3, "{} {}", b.eps_p, a.eps_p);
+        assert!(rel(b.damage - old.damage, factor * (a.damage - old.damage)) < 1e-3);
+        assert!(rel(b.eps_p_rate, a.eps_p_rate) < 1e-3, "the rate stays that of eps");
+        assert!(rel(von_mises(&b.tau), von_mises(&a.tau)) < 1e-6);
     }
 
     #[test]

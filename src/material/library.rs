@@ -64,6 +64,7 @@ pub fn weldox_460e() -> JohnsonCook {
         conductivity: 50.0,
         damage: DamageConstants { d1: 0.0705, d2: 1.732, d3: -0.54, d4: -0.015, d5: 0.0, cutoff_triaxiality: None },
         damage_coupling: 0.0,
+        damage_equivalent_strain: false,
         theta: JohnsonCook::DEFAULT_THETA,
     }
 }
@@ -99,15 +100,16 @@ pub fn weldox_460e_borvik() -> JohnsonCook {
 /// strain from a threshold `p_d = 0` for this steel and fracture comes when
 /// it reaches `D_C`, that is when the Johnson–Cook damage `D` of this crate
 /// (`∫ dε̄/ε_f`) reaches 1 — the locus as it stands, with 30 % of the flow
-/// stress lost by then. Two differences from their model. They integrate
-/// hardening and damage over the damage-equivalent strain
-/// `∫ (1 − D_C D) dε̄`, this crate over `ε̄`: on a steady path theirs is
-/// about 15 % smaller at fracture, so their point fails at about 15 % more
-/// plastic strain and hardens less on the way. And the fracture criterion
+/// stress lost by then. Hardening and damage run, as theirs, over the
+/// damage-equivalent strain `r = ∫ (1 − D_C D) dε̄`
+/// ([`JohnsonCook::damage_equivalent_strain`]; on a steady path `r` is
+/// about 15 % smaller than `ε̄` at fracture, so a point fails at more
+/// plastic strain and hardens less on the way; before 2026-11-28 this set
+/// ran over `ε̄`). One difference from their model: the fracture criterion
 /// is the case's (`critical_damage = 1` of the per-particle damage
 /// criterion is theirs: an element erodes at `D_C`).
 pub fn weldox_460e_borvik_coupled() -> JohnsonCook {
-    JohnsonCook { damage_coupling: 0.3, ..weldox_460e_borvik() }
+    JohnsonCook { damage_coupling: 0.3, damage_equivalent_strain: true, ..weldox_460e_borvik() }
 }
 
 /// Weldox 460 E as [`weldox_460e`], with the damage locus cut off below
@@ -166,6 +168,7 @@ pub fn ofhc_copper() -> JohnsonCook {
         conductivity: 0.0,
         damage: NO_DAMAGE,
         damage_coupling: 0.0,
+        damage_equivalent_strain: false,
         theta: JohnsonCook::DEFAULT_THETA,
     }
 }
