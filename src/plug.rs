@@ -90,7 +90,8 @@ pub const BOND_RADIUS_FACTOR: Real = 0.55;
 /// fill (module doc).
 struct Bonds<'a> {
     quad: &'a QuadraturePoints,
-    broken: Vec<bool>,
+    /// Whether the solver fractures points (`point_broken`).
+    fracturing: bool,
     /// The broken points, and a grid over them (`None`: no point is broken).
     broken_ids: Vec<usize>,
     broken_grid: Option<CellGrid>,
@@ -118,15 +119,14 @@ impl<'a> Bonds<'a> {
     fn new(model: &'a Model, cracks: &CrackGrowth) -> Self {
         let quad = &model.quad;
         let fracturing = cracks.params.fractures_points();
-        let broken: Vec<bool> = (0..quad.len()).map(|q| point_broken(quad, fracturing, q)).collect();
-        let broken_ids: Vec<usize> = (0..quad.len()).filter(|&q| broken[q]).collect();
+        let broken_ids: Vec<usize> = (0..quad.len()).filter(|&q| point_broken(quad, fracturing, q)).collect();
         let h_min = model.particles.spacing.iter().cloned().fold(Real::INFINITY, Real::min);
         let cell = 2.0 * BOND_RADIUS_FACTOR * h_min;
         let broken_grid = (!broken_ids.is_empty() && cell > 0.0 && cell.is_finite()).then(|| {
             let x: Vec<Vec2> = broken_ids.iter().map(|&q| quad.x0[q]).collect();
             CellGrid::new(&x, cell)
         });
-        Bonds { quad, broken, broken_ids, broken_grid, all: OnceCell::new(), cell }
+        Bonds { quad, fracturing, broken_ids, broken_grid, all: OnceCell::new(), cell }
     }
 
     /// Whether any point is broken.
@@ -151,7 +151,7 @@ impl<'a> Bonds<'a> {
         }
         let all = self.all.get_or_init(|| CellGrid::new(&q.x0, self.cell));
         let mut intact = false;
-        all.for_each_candidate(&mid, r, |k| intact |= !self.broken[k] && near(k));
+        all.for_each_candidate(&mid, r, |k| intact |= near(k) && !point_broken(q, self.fracturing, k));
         intact
     }
 }
