@@ -403,6 +403,10 @@ pub struct Shot {
     pub wall: Real,
     /// The run's directory.
     pub dir: PathBuf,
+    /// Mass added by mass scaling, kg (kg/m in plane strain; 0 without it,
+    /// `[time] mass_scaling`).
+    #[serde(default)]
+    pub added_mass: Real,
 }
 
 impl Shot {
@@ -805,6 +809,7 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
                 steps: s.steps,
                 wall: t.elapsed().as_secs_f64(),
                 dir,
+                added_mass: s.mass_scaling.map_or(0.0, |a| a.mass),
             };
             let kept = FinishedRun { writer: crate::checkpoint::this_writer(), shot: shot.clone() };
             // Not written (a full disk): `--resume` runs it again; the table has it.
@@ -1087,6 +1092,15 @@ pub fn report(header: &str, study: &Study) -> String {
             }
         )),
         None => s.push_str("Recht–Ipson fit: fewer than two perforating runs.\n\n"),
+    }
+    if let Some(most) =
+        study.shots.iter().filter(|x| x.added_mass > 0.0).max_by(|a, b| a.added_mass.total_cmp(&b.added_mass))
+    {
+        s.push_str(&format!(
+            "Mass scaling (`time.mass_scaling`, not in SPEC §5) added mass at rest to hold the step: at most {:.4e} kg \
+             (kg/m in plane strain), in the run at {:.2} m/s; each run's summary gives its own.\n\n",
+            most.added_mass, most.speed
+        ));
     }
     s.push_str(&format!("{DEFINITIONS}\n\n![v_r against v_i](ballistic.png)\n"));
     s
@@ -1446,6 +1460,7 @@ mod tests {
             tip_hardening: None,
             steps: 0,
             wall: 0.0,
+            added_mass: 0.0,
             dir: PathBuf::new(),
         }
     }

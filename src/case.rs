@@ -423,6 +423,15 @@ pub struct TimeSpec {
     /// from SPEC §5, off when absent ([`crate::bulk_viscosity`]).
     #[serde(default)]
     pub bulk_viscosity: Option<crate::bulk_viscosity::BulkViscosity>,
+    /// Mass scaling, a fraction of the spacing step `Δt₀` in (0, 1]: the
+    /// step is kept at or above this fraction of `Δt₀` by adding mass, at
+    /// rest, to the particles that would take it lower (light crack-face
+    /// children, steep rows at a crack; [`crate::stability`]). A
+    /// deviation from SPEC §5, off when absent; the run reports the mass
+    /// added and the kinetic energy it took out. Needs the adaptive step
+    /// (no `fixed_dt`).
+    #[serde(default)]
+    pub mass_scaling: Option<Real>,
 }
 
 fn half() -> Real {
@@ -768,6 +777,19 @@ impl Case {
         }
         for (key, message) in self.time.bulk_viscosity.map_or(Vec::new(), |b| b.problems()) {
             add(format!("time.bulk_viscosity.{key}"), message);
+        }
+        if let Some(f) = self.time.mass_scaling {
+            if !(f > 0.0 && f <= 1.0) {
+                add(
+                    "time.mass_scaling".into(),
+                    format!("must lie in (0, 1] (a fraction of the spacing step), got {f}"),
+                );
+            } else if self.time.fixed_dt.is_some() {
+                add(
+                    "time.mass_scaling".into(),
+                    "needs the adaptive step: leave out time.fixed_dt, or mass_scaling".into(),
+                );
+            }
         }
         if let Some(dt) = self.time.fixed_dt {
             positive(&mut add, "time.fixed_dt", dt, "s");

@@ -58,7 +58,8 @@
 //! time and the non-local fracture parameters, issue #19; 7 the adaptive
 //! stable step and the deformable contact, issues #19 and #20; 8 the crack
 //! events' own damage, [`crate::fracture::CrackEvent::damage`]; 9 their
-//! adiabatic hardening; 10 the quadrature points' cell length). The payload is
+//! adiabatic hardening; 10 the quadrature points' cell length; 11 the mass
+//! scaling's added mass and its account). The payload is
 //! [postcard](https://docs.rs/postcard) 1.x, whose wire format is stable
 //! within the major version: fields in declaration order, no names; an
 //! `f64` as its eight IEEE-754 bytes, so values (NaN payloads, −0.0)
@@ -135,8 +136,11 @@ pub const MAGIC: [u8; 8] = *b"PLUGCKPT";
 /// version 9 their adiabatic hardening
 /// ([`crate::fracture::CrackEvent::hardening`]), version 10 the
 /// quadrature points' cell length
-/// ([`crate::quadrature::QuadraturePoints::length`], the bulk viscosity's).
-pub const FORMAT_VERSION: u32 = 10;
+/// ([`crate::quadrature::QuadraturePoints::length`], the bulk viscosity's),
+/// version 11 the mass scaling's added mass
+/// ([`crate::particles::Particles::added_mass`],
+/// [`crate::stability::AddedMass`], [`crate::step::Energies::mass_scaling`]).
+pub const FORMAT_VERSION: u32 = 11;
 /// Subdirectory of a run's output directory that holds its checkpoints.
 pub const DIRECTORY: &str = "checkpoints";
 /// File name extension of a checkpoint.
@@ -493,6 +497,7 @@ fn restore(mut sim: Simulation, case: &Case) -> Result<Simulation, String> {
     m.gather.copy_entries(&m.qp_shape);
     sim.heat = case.heat_conduction_for(&sim.model).map_err(|e| format!("heat conduction: {e}"))?;
     sim.bulk_viscosity = case.bulk_viscosity();
+    sim.mass_scaling = case.time.mass_scaling;
     if let Some(c) = sim.cracks.as_mut() {
         c.refresh_segments(&sim.model);
     }

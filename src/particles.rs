@@ -82,8 +82,13 @@ pub struct Particles {
     pub f_int: Vec<Vec2>,
     /// External force (contact, loads), N.
     pub f_ext: Vec<Vec2>,
-    /// Lumped mass `m_I`, kg (per unit depth in plane strain).
+    /// Lumped mass `m_I`, kg (per unit depth in plane strain), including
+    /// `added_mass`.
     pub mass: Vec<Real>,
+    /// Mass added to `m_I` by mass scaling, kg ([`crate::stability`],
+    /// `[time] mass_scaling`; zero without it): kept across the re-lumping
+    /// at a crack change, and halved with the mass at a split.
+    pub added_mass: Vec<Real>,
     /// Nodal volume `ΔV_I` used in the RK sums, m³ (m² per unit depth in plane strain,
     /// the area in axisymmetry: the kernel weight is a 2D measure).
     pub volume: Vec<Real>,
@@ -122,6 +127,7 @@ impl Particles {
             f_int,
             f_ext,
             mass,
+            added_mass,
             volume,
             spacing,
             support,
@@ -138,6 +144,7 @@ impl Particles {
             f_int.len(),
             f_ext.len(),
             mass.len(),
+            added_mass.len(),
             volume.len(),
             spacing.len(),
             support.len(),
@@ -169,6 +176,7 @@ impl Particles {
         self.f_int.push(Vec2::zeros());
         self.f_ext.push(Vec2::zeros());
         self.mass.push(0.0);
+        self.added_mass.push(0.0);
         self.volume.push(volume);
         self.spacing.push(spacing);
         self.support.push(support);
@@ -195,6 +203,7 @@ impl Particles {
         c(&mut self.f_int, i);
         c(&mut self.f_ext, i);
         c(&mut self.mass, i);
+        c(&mut self.added_mass, i);
         c(&mut self.volume, i);
         c(&mut self.spacing, i);
         c(&mut self.support, i);
@@ -218,6 +227,7 @@ impl Particles {
         p(&mut self.f_int, order);
         p(&mut self.f_ext, order);
         p(&mut self.mass, order);
+        p(&mut self.added_mass, order);
         p(&mut self.volume, order);
         p(&mut self.spacing, order);
         p(&mut self.support, order);

@@ -81,6 +81,12 @@ pub struct RunSummary {
     /// step and the smallest taken (step, time, particle); `None` with a
     /// fixed step.
     pub stable_step: Option<(Real, (Real, Real, usize))>,
+    /// Mass scaling's account ([`crate::stability::AddedMass`]); `None`
+    /// without it.
+    pub mass_scaling: Option<crate::stability::AddedMass>,
+    /// The deformable bodies' mass at the end, added mass included, kg
+    /// (kg/m in plane strain).
+    pub total_mass: Real,
     pub snapshots: usize,
     pub setup_wall: Duration,
     pub loop_wall: Duration,
@@ -213,6 +219,7 @@ pub fn build_simulation(case: &Case) -> Result<Simulation, RunError> {
     sim.heat = case.heat_conduction_for(&sim.model)?;
     sim.heat_every = case.heat.every;
     sim.bulk_viscosity = case.bulk_viscosity();
+    sim.mass_scaling = case.time.mass_scaling;
     if case.fracture.criterion != crate::fracture::Criterion::None {
         sim.cracks = Some(crate::fracture::CrackGrowth::new(case.fracture));
     }
@@ -561,6 +568,8 @@ fn time_loop(
         time: sim.time,
         dt: sim.dt,
         stable_step: sim.stable.as_ref().map(|s| (s.base, s.smallest)),
+        mass_scaling: sim.mass_scaling.and(sim.stable.as_ref()).map(|s| s.added),
+        total_mass: sim.model.particles.total_mass(),
         snapshots: out.snapshots,
         setup_wall,
         loop_wall,

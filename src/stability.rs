@@ -58,6 +58,28 @@
 //!   `changes_of_step_keep_the_central_difference_second_order` (with the
 //!   new step alone, alternating steps pump the energy up until it blows
 //!   up).
+//! - **Mass scaling** (`[time] mass_scaling = f`, off by default; not in
+//!   SPEC §5 or \[RL10\]). On the fine rungs the step falls far below the
+//!   spacing step once cracks run: at 96 rows through the 12 mm plate from
+//!   10.8 ns to 2.5 ns by 60 µs, set by light crack-face children and
+//!   steep rows at the crack, a few particles out of 160,000; a held run
+//!   then takes hours. With `f`, every evaluation first adds mass to each
+//!   particle whose bound would take the elastic step below `f · Δt₀`,
+//!   as little as brings its bound to the target
+//!   ([`BoundScratch::scale_masses`]), as the common explicit codes do
+//!   (LS-DYNA's `DT2MS`). The mass is added at rest: the particle's
+//!   velocity drops so that its momentum stays, and the kinetic energy
+//!   this takes out is booked in the balance
+//!   ([`crate::step::Energies::mass_scaling`]). Added mass stays on its
+//!   particle ([`crate::particles::Particles::added_mass`]): a split
+//!   halves it with the mass, the re-lumping at a crack keeps it. The run
+//!   summary reports it. It changes a crack face's inertia slightly (the
+//!   particles it touches are a crack's first rows), so it is an option
+//!   whose effect is measured (`docs/performance.md`), not the default.
+//!   Tests: `mass_scaling_holds_the_step_at_its_floor_and_keeps_the_margin`
+//!   (the step, the mass only where needed, momentum, the energy account,
+//!   and the exact highest frequency of the scaled system),
+//!   `splits_keep_the_mass_that_mass_scaling_added` (`tests/fracture.rs`).
 
 use crate::bulk_viscosity::step_factor;
 use crate::material::{Constitutive, Material};
@@ -193,6 +215,63 @@ impl BoundScratch {
     }
 }
 
+impl BoundScratch {
+    /// Mass scaling: the factors `m_new / m_I` (> 1) that bring every
+    /// particle's bound `ω_I²` ([`BoundScratch::bounds`], as filled for
+    /// `model`) down to `target`, with as little mass added as this
+    /// bound allows.
+    ///
+    /// A particle's bound is its own term and its neighbours':
+    /// `ω_I² = S_I + O_I`, `S_I = Σ_q k_q w_q |b_I(q)|² / m_I` and
+    /// `O_I = Σ_q k_q w_q (|b_I(q)|/√m_I) Σ_{J≠I} |b_J(q)|/√m_J`. Scaling
+    /// `m_I` by `s` scales `S_I` by `1/s` and `O_I` by `1/√s`, so with
+    /// `y = 1/√s` the bound meets the target at the root of
+    /// `S_I y² + O_I y = target`. The particles above the target are taken
+    /// stiffest first (ties by index), each with its neighbours' masses as
+    /// scaled before it; scaling one lowers its neighbours' bounds, so a
+    /// particle the ones before it brought down gets no mass, and no bound
+    /// rises: afterwards every bound is at most `target` (to round-off).
+    pub fn scale_masses(&self, model: &Model, target: Real) -> Vec<(usize, Real)> {
+        let mut over: Vec<usize> = (0..self.bounds.len()).filter(|&i| self.bounds[i] > target).collect();
+        if over.is_empty() {
+            return Vec::new();
+        }
+        over.sort_by(|&a, &b| self.bounds[b].total_cmp(&self.bounds[a]).then(a.cmp(&b)));
+        let (table, gather) = (&model.qp_shape, &model.gather);
+        // `1/√s_J` of the particles scaled so far.
+        let mut shrink: std::collections::HashMap<usize, Real> = std::collections::HashMap::new();
+        let mut scaled = Vec::new();
+        for i in over {
+            let (mut own, mut others) = (0.0, 0.0);
+            for j in gather.range(i) {
+                let (k, q) = (gather.entry[j] as usize, gather.point[j] as usize);
+                let modulus_w = self.points[q].1;
+                if self.row_factor[q] == 0.0 || modulus_w == 0.0 {
+                    continue;
+                }
+                let q0 = q - q % PARALLEL_PIECE;
+                let (entries, first) = (&self.entries[q / PARALLEL_PIECE], table.offsets[q0]);
+                let factor = |k: usize| shrink.get(&(table.index[k] as usize)).copied().unwrap_or(1.0);
+                let e_i = entries[k - first] * factor(k);
+                let rest: Real = table.range(q).filter(|&m| m != k).map(|m| entries[m - first] * factor(m)).sum();
+                own += modulus_w * e_i * e_i;
+                others += modulus_w * e_i * rest;
+            }
+            if own + others <= target {
+                continue;
+            }
+            let y = if own > 0.0 {
+                (-others + (others * others + 4.0 * own * target).sqrt()) / (2.0 * own)
+            } else {
+                target / others
+            };
+            shrink.insert(i, y);
+            scaled.push(i);
+        }
+        scaled.into_iter().map(|i| (i, 1.0 / shrink[&i].powi(2))).collect()
+    }
+}
+
 /// The modulus a point resists a change of its strain with, Pa: the
 /// P-wave modulus `K + 4G/3 = ρ c_L²` of its material; none if it is eroded;
 /// and while cracks grow (`fractured`: its damage and `J`), the bulk
@@ -241,9 +320,26 @@ pub struct StableStep {
     /// The smallest step taken so far, s, the time it was chosen at, s,
     /// and the particle that set it.
     pub smallest: (Real, Real, usize),
+    /// Mass scaling ([`StableStep::evaluate`] with a floor): the mass
+    /// added so far, kg, the particles that carry some, and the kinetic
+    /// energy taken out by adding it at rest, J
+    /// ([`crate::step::Energies::mass_scaling`]).
+    pub added: AddedMass,
     /// Not in checkpoints: rewritten by every evaluation.
     #[serde(skip)]
     scratch: BoundScratch,
+}
+
+/// The running account of mass scaling ([`StableStep::evaluate`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct AddedMass {
+    /// Mass added so far, kg (per unit depth in plane strain).
+    pub mass: Real,
+    /// Evaluations that added mass.
+    pub evaluations: u64,
+    /// The largest mass added to one particle at once, as a multiple of
+    /// its mass before.
+    pub largest_factor: Real,
 }
 
 /// Steps between two evaluations of the stable step when no crack changed:
@@ -262,6 +358,7 @@ impl StableStep {
             reference,
             every: EVALUATE_EVERY,
             smallest: (base, 0.0, i),
+            added: AddedMass::default(),
             scratch: BoundScratch::default(),
         }
     }
@@ -270,8 +367,45 @@ impl StableStep {
     /// with `damping_ratio` the largest damping ratio of the bulk viscosity
     /// on a full lattice (0 without it; the step is then the elastic one bit
     /// for bit), and the particle that sets it.
-    pub fn evaluate(&mut self, model: &Model, time: Real, fracturing: bool, damping_ratio: Real) -> Real {
+    ///
+    /// With `mass_floor` (mass scaling, `[time] mass_scaling`), mass is
+    /// first added to every particle whose bound would take the elastic
+    /// step below `mass_floor · Δt₀` ([`BoundScratch::scale_masses`]),
+    /// at rest: its velocity drops so that its momentum stays, and the
+    /// kinetic energy this takes out is returned (J; 0 without mass
+    /// added), for the energy account.
+    pub fn evaluate(
+        &mut self,
+        model: &mut Model,
+        time: Real,
+        fracturing: bool,
+        damping_ratio: Real,
+        mass_floor: Option<Real>,
+    ) -> (Real, Real) {
         self.scratch.fill(model, true, fracturing);
+        let mut removed = 0.0;
+        if let Some(floor) = mass_floor {
+            let target = (self.reference / floor).powi(2);
+            let scaled = self.scratch.scale_masses(model, target);
+            if !scaled.is_empty() {
+                let p = &mut model.particles;
+                for &(i, factor) in &scaled {
+                    let (m, v) = (p.mass[i], p.v[i]);
+                    let dm = m * (factor - 1.0);
+                    // Held components keep their velocity (zero, or driven).
+                    let keep = |fix: u8| if p.flags[i].has(fix) { 1.0 } else { 1.0 / factor };
+                    let v_new = Vec2::new(v.x * keep(ParticleFlags::FIX_X), v.y * keep(ParticleFlags::FIX_Y));
+                    removed += 0.5 * m * v.norm_squared() - 0.5 * (m + dm) * v_new.norm_squared();
+                    p.mass[i] = m + dm;
+                    p.added_mass[i] += dm;
+                    p.v[i] = v_new;
+                    self.added.mass += dm;
+                    self.added.largest_factor = self.added.largest_factor.max(factor);
+                }
+                self.added.evaluations += 1;
+                self.scratch.fill(model, true, fracturing);
+            }
+        }
         let (w2, i) = stiffest(&self.scratch.bounds);
         let w = w2.sqrt();
         let elastic =
@@ -282,6 +416,6 @@ impl StableStep {
         if dt < self.smallest.0 {
             self.smallest = (dt, time, i);
         }
-        dt
+        (dt, removed)
     }
 }

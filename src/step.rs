@@ -45,13 +45,16 @@ pub struct Energies {
     pub rigid_work: Real,
     /// Total kinetic energy (particles + rigid bodies) at the start.
     pub initial_kinetic: Real,
+    /// Kinetic energy taken out by mass scaling, which adds mass at rest
+    /// ([`crate::stability::StableStep::evaluate`]; 0 without it).
+    pub mass_scaling: Real,
 }
 
 impl Energies {
-    /// `kinetic + rigid_kinetic + internal − (contact_work + rigid_work)`:
-    /// stays at `initial_kinetic` in an exact integration.
+    /// `kinetic + rigid_kinetic + internal − (contact_work + rigid_work)
+    /// + mass_scaling`: stays at `initial_kinetic` in an exact integration.
     pub fn total(&self) -> Real {
-        self.kinetic + self.rigid_kinetic + self.internal - (self.contact_work + self.rigid_work)
+        self.kinetic + self.rigid_kinetic + self.internal - (self.contact_work + self.rigid_work) + self.mass_scaling
     }
     /// Energy dissipated by the contact algorithm, `−(contact_work + rigid_work)`.
     pub fn contact_dissipation(&self) -> Real {
@@ -253,6 +256,13 @@ pub struct Simulation {
     pub stable: Option<StableStep>,
     /// The step before this one, s (`dt` at the first step).
     pub dt_previous: Real,
+    /// Mass scaling: the smallest elastic step as a fraction of the rule's
+    /// step `Δt₀`, held by adding mass to the particles that would take it
+    /// lower ([`crate::stability::StableStep::evaluate`]; `[time]
+    /// mass_scaling`); `None`: no mass is added (SPEC §5). Not in
+    /// checkpoints: set from the case, as `bulk_viscosity`.
+    #[serde(skip)]
+    pub mass_scaling: Option<Real>,
     /// Per-point internal-energy increments of the last step (scratch; this
     /// and `kinetic_scratch` are not in checkpoints: each step resizes and
     /// rewrites them before reading them).
@@ -298,6 +308,7 @@ impl Simulation {
         Simulation {
             stable,
             dt_previous: dt,
+            mass_scaling: None,
             model,
             time: 0.0,
             step: 0,
@@ -425,9 +436,10 @@ impl Simulation {
         let Some(stable) = self.stable.as_mut() else {
             return;
         };
-        let fracturing =
-            self.cracks.as_ref().is_some_and(|c| c.params.critical_value().is_some() && c.params.fractures_points());
-        let dt = stable.evaluate(&self.model, self.time, fracturing, self.viscous_damping);
+        let fracturing = self.cracks.as_ref().is_some_and(|c| c.params.fractures_points());
+        let (dt, removed) =
+            stable.evaluate(&mut self.model, self.time, fracturing, self.viscous_damping, self.mass_scaling);
+        self.energies.mass_scaling += removed;
         self.dt = dt;
     }
 
@@ -552,7 +564,7 @@ impl Simulation {
         // Erosion of inverted failed points (`crate::fracture` module doc).
         let erosion = self.cracks.as_ref().map(|c| c.params).filter(|p| cracking && p.erode_inverted);
         // Not with the non-local criterion (`FractureParameters::fractures_points`).
-        let fracturing = cracking && self.cracks.as_ref().is_some_and(|c| c.params.fractures_points());
+        let fracturing = self.cracks.as_ref().is_some_and(|c| c.params.fractures_points());
         // One increment per point (a simulation read from a checkpoint
         // starts with none).
         self.work_scratch.resize(self.model.quad.len(), 0.0);

@@ -184,3 +184,17 @@ fn bulk_viscosity_is_off_unless_asked_and_its_coefficients_are_checked() {
     let s = err_of(&with("end = 30.0e-6", "end = 30.0e-6\nbulk_viscosity = { linaer = 0.1 }"));
     assert!(s.contains("linaer"), "{s}");
 }
+
+#[test]
+fn mass_scaling_is_off_unless_asked_and_its_floor_is_checked() {
+    let case = Case::from_str_with(GOOD, "good.toml", &[]).unwrap();
+    assert_eq!(case.time.mass_scaling, None);
+    let on = with("end = 30.0e-6", "end = 30.0e-6\nmass_scaling = 0.5");
+    assert_eq!(Case::from_str_with(&on, "good.toml", &[]).unwrap().time.mass_scaling, Some(0.5));
+    for bad in ["0.0", "1.5", "-0.2"] {
+        let s = err_of(&with("end = 30.0e-6", &format!("end = 30.0e-6\nmass_scaling = {bad}")));
+        assert!(s.contains("time.mass_scaling") && s.contains("(0, 1]"), "{s}");
+    }
+    let s = err_of(&with("end = 30.0e-6", "end = 30.0e-6\nmass_scaling = 0.5\nfixed_dt = 1.0e-9"));
+    assert!(s.contains("time.mass_scaling") && s.contains("fixed_dt"), "{s}");
+}

@@ -79,10 +79,16 @@ fn strictly_crosses(a: &Vec2, b: &Vec2, x: &Vec2, p: &Vec2) -> bool {
 struct Invariants {
     mass: Real,
     momentum: Vec2,
+    /// Mass added by mass scaling (`Particles::added_mass`).
+    added: Real,
 }
 
 fn snapshot(m: &Model) -> Invariants {
-    Invariants { mass: m.particles.total_mass(), momentum: m.particles.momentum() }
+    Invariants {
+        mass: m.particles.total_mass(),
+        momentum: m.particles.momentum(),
+        added: m.particles.added_mass.iter().sum(),
+    }
 }
 
 /// Mass and momentum unchanged, reproduction at every quadrature point,
@@ -97,6 +103,11 @@ fn check_invariants(m: &Model, growth: &CrackGrowth, before: &Invariants, what: 
     let vmax = p.v.iter().map(|v| v.norm()).fold(0.0, Real::max).max(1.0);
     let dp = (p.momentum() - before.momentum).norm();
     assert!(dp <= 1e-12 * before.mass * vmax, "{what}: momentum changed by {dp:e}");
+    // Mass scaling's added mass stays on the particles through the
+    // split and the re-lumping, and is part of their mass.
+    let added: Real = p.added_mass.iter().sum();
+    assert!((added - before.added).abs() <= 1e-12 * before.mass, "{what}: added mass {added} vs {}", before.added);
+    assert!((0..p.len()).all(|i| p.added_mass[i] >= 0.0 && p.mass[i] > p.added_mass[i]), "{what}: added mass");
     eprintln!(
         "{what}: relative mass error {:.2e}, momentum error {:.2e} (of M v_max)",
         (mass - before.mass).abs() / before.mass,
@@ -203,6 +214,36 @@ fn splits_conserve_mass_and_momentum_and_reproduction() {
             assert!(f.has(ParticleFlags::CRACK_FACE) && f.has(ParticleFlags::SLAVE));
         }
     }
+}
+
+/// The same crack through particles that carry mass added by mass
+/// scaling (half their own again, on every particle left of the band's
+/// foot): the splits halve it with the mass and the re-lumping keeps it,
+/// so the added total, the mass and the momentum stay
+/// (`check_invariants`).
+#[test]
+fn splits_keep_the_mass_that_mass_scaling_added() {
+    let (nx, ny) = (25, 9);
+    let mut m = plate(nx, ny);
+    non_uniform_velocity(&mut m);
+    let top = (ny - 1) as Real * H;
+    let xc = 10.0 * H;
+    for i in 0..m.particles.len() {
+        if m.particles.x0[i].x < xc + 0.5 * H {
+            let dm = 0.5 * m.particles.mass[i];
+            m.particles.added_mass[i] = dm;
+            m.particles.mass[i] += dm;
+        }
+    }
+    let added: Real = m.particles.added_mass.iter().sum();
+    set_field(&mut m, |x| 0.6 * (-((x.x - xc - 0.4 * (top - x.y)) / H).powi(2)).exp());
+    let mut g = CrackGrowth::new(params(Criterion::EffectiveStrain));
+    drive(&mut m, &mut g, 30);
+    assert!(g.cracks[0].arrested.is_some(), "the crack runs through: {:?}", g.events);
+    let carried = g.events.iter().flat_map(|e| e.particles[..2].to_vec()).filter(|&i| m.particles.added_mass[i] > 0.0);
+    assert!(carried.count() >= 2, "some split particle carries added mass");
+    let end: Real = m.particles.added_mass.iter().sum();
+    assert!((end - added).abs() <= 1e-12 * added, "{end} vs {added}");
 }
 
 #[test]

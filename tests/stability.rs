@@ -233,3 +233,65 @@ fn changes_of_step_keep_the_central_difference_second_order() {
     let error = a.iter().zip(b).map(|(x, y)| (x - y).norm()).fold(0.0, Real::max);
     assert!(error < 1e-2 * scale, "displacement differs by {error:e} (scale {scale:e})");
 }
+
+/// Mass scaling (`[time] mass_scaling`) after the extreme split child of
+/// `the_step_follows_a_light_particle`: with a floor of half the spacing
+/// step, the step stays there (the adaptive step alone goes below a
+/// quarter); mass goes only to the light particle, at rest (its momentum
+/// stays, the kinetic energy taken out is booked), and no more than the
+/// bound asks: its bound sits on the target. Checked against the exact
+/// highest frequency of the scaled system (assembled independently): the
+/// step keeps the margin the spacing step has on the reference lattice,
+/// and the run keeps its energy.
+#[test]
+fn mass_scaling_holds_the_step_at_its_floor_and_keeps_the_margin() {
+    let model = plate(9, 6);
+    let dt0 = 0.5 * model.min_spacing() / model.max_wave_speed();
+    let margin0 = exact_highest_frequency(&model) * dt0;
+    let mut sim = vibrating(model, TimeStepRule::Cfl { safety: 0.5 });
+    sim.mass_scaling = Some(0.5);
+    for _ in 0..10 {
+        sim.step().unwrap();
+    }
+    let light = 22;
+    let m_light = sim.model.particles.mass[light] / 100.0;
+    sim.model.particles.mass[light] = m_light;
+    let momentum = sim.model.particles.momentum();
+    let kinetic = plugsim::step::kinetic_energy(&sim.model.particles.mass, &sim.model.particles.v);
+    sim.refresh_time_step();
+    let p = &sim.model.particles;
+    assert!((sim.dt / dt0 - 0.5).abs() < 1e-9, "the step {} of the spacing step's", sim.dt / dt0);
+    // Only the light particle gets mass, and its row meets the target.
+    let added: Vec<usize> = (0..p.len()).filter(|&i| p.added_mass[i] > 0.0).collect();
+    assert_eq!(added, vec![light]);
+    assert!((p.mass[light] - m_light - p.added_mass[light]).abs() < 1e-15 * p.mass[light]);
+    let stable = sim.stable.as_ref().unwrap();
+    assert_eq!(stable.added.mass, p.added_mass[light]);
+    let bounds = frequency_bounds(&sim.model, true, false);
+    let top = bounds.iter().cloned().fold(0.0, Real::max);
+    let target = (stable.reference / 0.5).powi(2);
+    assert!((top / target - 1.0).abs() < 1e-9, "the stiffest bound {top:e} against the target {target:e}");
+    assert!((bounds[light] / target - 1.0).abs() < 1e-9);
+    // Momentum kept; the kinetic energy taken out is what the balance books.
+    let dp = (sim.model.particles.momentum() - momentum).norm();
+    assert!(dp <= 1e-13 * momentum.norm().max(1e-30), "momentum moved by {dp:e}");
+    let after = plugsim::step::kinetic_energy(&sim.model.particles.mass, &sim.model.particles.v);
+    assert!(sim.energies.mass_scaling > 0.0);
+    assert!((kinetic - after - sim.energies.mass_scaling).abs() < 1e-12 * kinetic);
+    // The exact highest frequency of the scaled system: the step keeps the
+    // spacing step's margin (within the bound's tracking, +15 %).
+    let margin = exact_highest_frequency(&sim.model) * sim.dt;
+    eprintln!(
+        "light particle: {:.2}x its mass after scaling; ω dt {margin:.3} (reference lattice {margin0:.3}); kinetic energy out {:.2e} of {kinetic:.2e} J",
+        sim.model.particles.mass[light] / m_light,
+        sim.energies.mass_scaling
+    );
+    assert!(margin <= 1.15 * margin0, "ω dt = {margin:.3} against {margin0:.3} on the reference lattice");
+    let mut largest: Real = 0.0;
+    for _ in 0..400 {
+        sim.step().unwrap();
+        largest = largest.max(sim.energies.drift().abs());
+    }
+    assert!(largest < 0.02, "energy drift {largest} with mass scaling");
+    assert!(sim.dt >= 0.5 * dt0 * (1.0 - 1e-9));
+}

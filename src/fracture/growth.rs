@@ -1207,6 +1207,7 @@ impl CrackGrowth {
             p.x0[k] = s.vertex + b * (sign * s.offset);
             p.volume[k] *= f;
             p.mass[k] *= f;
+            p.added_mass[k] *= f;
             p.f_ext[k] *= f;
             p.a[k] = Vec2::zeros();
             p.flags[k].set(ParticleFlags::CRACK_FACE | ParticleFlags::SLAVE);
@@ -1322,7 +1323,9 @@ impl CrackGrowth {
         model.gather.patch_into(&spare.qp_shape.offsets, &model.qp_shape, &rows_q, &touched, n, &mut spare.gather);
         std::mem::swap(&mut model.gather, &mut spare.gather);
         let touched: Vec<usize> = (0..n).filter(|&i| touched[i]).collect();
-        let before: Real = touched.iter().map(|&i| model.particles.mass[i]).sum();
+        // Re-lumped: the material's mass; the mass scaling added
+        // ([`crate::stability`]) stays on its particle.
+        let before: Real = touched.iter().map(|&i| model.particles.mass[i] - model.particles.added_mass[i]).sum();
         let mut floored = Vec::new();
         for &i in &touched {
             let m = model.lumped_mass(i);
@@ -1342,6 +1345,9 @@ impl CrackGrowth {
             for &i in touched.iter().filter(|i| !floored.contains(i)) {
                 p.mass[i] *= scale;
             }
+        }
+        for &i in &touched {
+            model.particles.mass[i] += model.particles.added_mass[i];
         }
         // Momentum: one uniform shift of the re-lumped particles' free components.
         let p = &mut model.particles;

@@ -689,7 +689,11 @@ impl FractureParameters {
     /// cracks grow: with the per-particle criteria, as before; not with
     /// `"nonlocal_damage"`, where the failure is the crack's over the
     /// material length and a point-wise stress drop would bring back the
-    /// mesh-size softening the average removes ([`nonlocal`]).
+    /// mesh-size softening the average removes ([`nonlocal`]). False
+    /// without a criterion, so true only where
+    /// [`FractureParameters::critical_value`] is some: the one test of "the
+    /// solver fractures points" (the material update, the stable step, the
+    /// plug's broken points).
     pub fn fractures_points(&self) -> bool {
         match self.criterion {
             Criterion::EffectiveStrain | Criterion::Damage => true,
