@@ -320,10 +320,10 @@ pub struct StableStep {
     /// The smallest step taken so far, s, the time it was chosen at, s,
     /// and the particle that set it.
     pub smallest: (Real, Real, usize),
-    /// Mass scaling ([`StableStep::evaluate`] with a floor): the mass
-    /// added so far, kg, the particles that carry some, and the kinetic
-    /// energy taken out by adding it at rest, J
-    /// ([`crate::step::Energies::mass_scaling`]).
+    /// Mass scaling's account ([`StableStep::evaluate`] with a floor; the
+    /// kinetic energy it took out is in
+    /// [`crate::step::Energies::mass_scaling`], the mass per particle in
+    /// [`crate::particles::Particles::added_mass`]).
     pub added: AddedMass,
     /// Not in checkpoints: rewritten by every evaluation.
     #[serde(skip)]
