@@ -882,6 +882,17 @@ impl Case {
         crate::thermal::HeatConduction::new(model, self.heat.safety_factor).map(Some)
     }
 
+    /// Set on `sim` what a run takes from this case and checkpoints do not
+    /// store: heat conduction ([`Case::heat_conduction_for`]), the bulk
+    /// viscosity and mass scaling. The one place for both a fresh run at
+    /// t = 0 and a run resumed from a checkpoint.
+    pub fn apply_unstored_settings(&self, sim: &mut crate::step::Simulation) -> Result<(), crate::thermal::HeatError> {
+        sim.heat = self.heat_conduction_for(&sim.model)?;
+        sim.bulk_viscosity = self.bulk_viscosity();
+        sim.mass_scaling = self.time.mass_scaling;
+        Ok(())
+    }
+
     /// TOML text of [`Case::resolved`].
     pub fn resolved_toml(&self) -> String {
         toml::to_string_pretty(&self.resolved()).unwrap_or_else(|e| format!("# could not serialize the case: {e}\n"))

@@ -495,9 +495,7 @@ fn restore(mut sim: Simulation, case: &Case) -> Result<Simulation, String> {
     let m = &mut sim.model;
     m.materials = setups.into_iter().map(|s| s.material).collect();
     m.gather.copy_entries(&m.qp_shape);
-    sim.heat = case.heat_conduction_for(&sim.model).map_err(|e| format!("heat conduction: {e}"))?;
-    sim.bulk_viscosity = case.bulk_viscosity();
-    sim.mass_scaling = case.time.mass_scaling;
+    case.apply_unstored_settings(&mut sim).map_err(|e| format!("heat conduction: {e}"))?;
     if let Some(c) = sim.cracks.as_mut() {
         c.refresh_segments(&sim.model);
     }

@@ -1012,15 +1012,16 @@ fn drive(
         }
     }
     if let Some(a) = s.mass_scaling {
+        let own = (s.total_mass - a.mass).max(f64::MIN_POSITIVE);
         println!(
             "  mass scaling (not in SPEC §5): {:.4e} kg added at rest ({:.4} % of the bodies' mass) in {} evaluations, at most {:.2}x one particle's mass at once; {:.4e} J of kinetic energy taken out (in the energy balance)",
             a.mass,
-            100.0 * a.mass / (s.total_mass - a.mass).max(f64::MIN_POSITIVE),
+            100.0 * a.mass / own,
             a.evaluations,
             a.largest_factor,
             s.energies.mass_scaling
         );
-        if a.mass > 0.01 * (s.total_mass - a.mass) {
+        if a.mass > 0.01 * own {
             println!("  WARNING: mass scaling added more than 1 % of the bodies' mass: the dynamics are no longer the model's; lower time.mass_scaling");
         }
     }

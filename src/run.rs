@@ -216,10 +216,8 @@ pub fn preflight(case: &Case) -> Result<Footprint, RunError> {
 /// for it ([`Case::heat_conduction`]).
 pub fn build_simulation(case: &Case) -> Result<Simulation, RunError> {
     let mut sim = build_simulation_without_cracks(case)?;
-    sim.heat = case.heat_conduction_for(&sim.model)?;
+    case.apply_unstored_settings(&mut sim)?;
     sim.heat_every = case.heat.every;
-    sim.bulk_viscosity = case.bulk_viscosity();
-    sim.mass_scaling = case.time.mass_scaling;
     if case.fracture.criterion != crate::fracture::Criterion::None {
         sim.cracks = Some(crate::fracture::CrackGrowth::new(case.fracture));
     }

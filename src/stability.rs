@@ -213,9 +213,7 @@ impl BoundScratch {
             *bound = sum;
         });
     }
-}
 
-impl BoundScratch {
     /// Mass scaling: the factors `m_new / m_I` (> 1) that bring every
     /// particle's bound `ω_I²` ([`BoundScratch::bounds`], as filled for
     /// `model`) down to `target`, with as little mass added as this
