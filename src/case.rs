@@ -523,6 +523,7 @@ pub const OUTPUT_FIELDS: &[&str] = &[
     "temperature",
     "damage",
     "adiabatic_hardening",
+    "average_triaxiality",
     "mass",
     "body",
     "flags",

@@ -59,7 +59,8 @@
 //! stable step and the deformable contact, issues #19 and #20; 8 the crack
 //! events' own damage, [`crate::fracture::CrackEvent::damage`]; 9 their
 //! adiabatic hardening; 10 the quadrature points' cell length; 11 the mass
-//! scaling's added mass and its account). The payload is
+//! scaling's added mass and its account; 12 the quadrature points'
+//! triaxiality integrated over the plastic strain). The payload is
 //! [postcard](https://docs.rs/postcard) 1.x, whose wire format is stable
 //! within the major version: fields in declaration order, no names; an
 //! `f64` as its eight IEEE-754 bytes, so values (NaN payloads, −0.0)
@@ -139,8 +140,10 @@ pub const MAGIC: [u8; 8] = *b"PLUGCKPT";
 /// ([`crate::quadrature::QuadraturePoints::length`], the bulk viscosity's),
 /// version 11 the mass scaling's added mass
 /// ([`crate::particles::Particles::added_mass`],
-/// [`crate::stability::AddedMass`], [`crate::step::Energies::mass_scaling`]).
-pub const FORMAT_VERSION: u32 = 11;
+/// [`crate::stability::AddedMass`], [`crate::step::Energies::mass_scaling`]),
+/// version 12 the quadrature points' triaxiality integrated over the
+/// plastic strain ([`crate::quadrature::QuadraturePoints::triaxiality_strain`]).
+pub const FORMAT_VERSION: u32 = 12;
 /// Subdirectory of a run's output directory that holds its checkpoints.
 pub const DIRECTORY: &str = "checkpoints";
 /// File name extension of a checkpoint.

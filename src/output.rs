@@ -595,8 +595,10 @@ fn v3(v: &Vec2) -> [f64; 3] {
 
 /// Per-point values projected together by [`particle_piece`]: the five
 /// entries of the Cauchy stress's block form (`xx, xy, yx, yy, zz`), then
-/// the five quadrature-point scalars a snapshot can carry.
-const PROJECTED: usize = 5 + 5;
+/// the five quadrature-point scalars a snapshot can carry, then `∫ η dε̄`
+/// (the numerator of `average_triaxiality`, whose denominator is the
+/// plastic strain's slot).
+const PROJECTED: usize = 5 + 5 + 1;
 
 /// Several quadrature fields projected in one pass over the gather table
 /// ([`Model::project`] of a fixed-size row): each entry gets the same
@@ -648,12 +650,14 @@ pub fn particle_piece(model: &Model, fields: &[String]) -> VtuPiece {
     }
     // The scalars' slots follow the stress's five in each projected row.
     let hardening = if want("adiabatic_hardening") { adiabatic_hardening(model) } else { vec![0.0; q.len()] };
+    // The last slot is `∫ η dε̄`, written as `average_triaxiality`.
     let scalar_fields: [(&str, &[Real]); PROJECTED - 5] = [
         ("plastic_strain", &q.eps_p),
         ("plastic_strain_rate", &q.eps_p_rate),
         ("temperature", &q.temperature),
         ("damage", &q.damage),
         ("adiabatic_hardening", &hardening),
+        ("average_triaxiality", &q.triaxiality_strain),
     ];
     let stress_wanted = want("stress") || want("effective_stress") || want("pressure");
     if stress_wanted || scalar_fields.iter().any(|(f, _)| want(f)) {
@@ -690,11 +694,26 @@ pub fn particle_piece(model: &Model, fields: &[String]) -> VtuPiece {
                     piece.with_point_data(DataArray::scalars("pressure", s.iter().map(|t| -mean_stress(t)).collect()));
             }
         }
-        for (c, (name, _)) in scalar_fields.iter().enumerate() {
+        let (last, eps_p) = (PROJECTED - 6, 0);
+        for (c, (name, _)) in scalar_fields.iter().enumerate().take(last) {
             if want(name) {
                 piece =
                     piece.with_point_data(DataArray::scalars(*name, projected.iter().map(|r| r.0[5 + c]).collect()));
             }
+        }
+        if want(scalar_fields[last].0) {
+            // The ratio of the projections, as the crack gates read it
+            // (`CrackGrowth::triaxiality`); 0 where nothing has flowed.
+            let ratio = |r: &Row<PROJECTED>| {
+                let (num, den) = (r.0[5 + last], r.0[5 + eps_p]);
+                if den > 0.0 {
+                    num / den
+                } else {
+                    0.0
+                }
+            };
+            piece =
+                piece.with_point_data(DataArray::scalars(scalar_fields[last].0, projected.iter().map(ratio).collect()));
         }
     }
     if want("mass") {

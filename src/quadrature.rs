@@ -34,6 +34,14 @@ pub struct QuadraturePoints {
     pub temperature: Vec<Real>,
     /// Johnson–Cook damage.
     pub damage: Vec<Real>,
+    /// The stress triaxiality integrated over the plastic strain,
+    /// `∫ η dε̄` (`η = σ_m/σ_eq` at each step's end;
+    /// [`crate::material::strain_path_increment`]): divided by `ε̄` it is
+    /// the average triaxiality of the point's strain path, the output
+    /// field `average_triaxiality`. The mechanics and the crack criteria
+    /// do not read it (a crack gate on it was tried: `docs/validation.md`,
+    /// "The compression gate read over the strain path").
+    pub triaxiality_strain: Vec<Real>,
     /// First Piola–Kirchhoff stress times the weight, `P w_q`, cached for the
     /// force gather, N·m (per unit depth): its in-plane block, aligned for
     /// the gather's scattered reads ([`InPlane`]), and its out-of-plane
@@ -89,10 +97,19 @@ impl QuadraturePoints {
             eps_p_rate,
             temperature,
             damage,
+            triaxiality_strain,
         } = self;
         let n = x0.len();
         let columns = [weight.len(), body.len(), eroded.len(), f_carry_slot.len(), f.len(), tau.len(), pw.len()];
-        let more_columns = [pw_zz.len(), eps_p.len(), eps_p_rate.len(), temperature.len(), damage.len(), length.len()];
+        let more_columns = [
+            pw_zz.len(),
+            eps_p.len(),
+            eps_p_rate.len(),
+            temperature.len(),
+            damage.len(),
+            length.len(),
+            triaxiality_strain.len(),
+        ];
         columns.iter().chain(&more_columns).all(|&l| l == n)
             && f_carry_slot.iter().all(|&s| s == NO_CARRY || (s as usize) < f_carry.len())
     }
@@ -109,6 +126,7 @@ impl QuadraturePoints {
         self.eps_p_rate.push(s.eps_p_rate);
         self.temperature.push(s.temperature);
         self.damage.push(s.damage);
+        self.triaxiality_strain.push(0.0);
         let pw = Block2::zeros();
         self.pw.push(pw.in_plane());
         self.pw_zz.push(pw.zz);
@@ -151,26 +169,5 @@ impl QuadraturePoints {
             temperature: self.temperature[q],
             damage: self.damage[q],
         }
-    }
-
-    /// Reorder every column so that new index `k` holds old point `order[k]`.
-    pub fn permute(&mut self, order: &[usize]) {
-        fn p<T: Copy>(v: &mut Vec<T>, order: &[usize]) {
-            let n: Vec<T> = order.iter().map(|&i| v[i]).collect();
-            *v = n;
-        }
-        p(&mut self.x0, order);
-        p(&mut self.weight, order);
-        p(&mut self.body, order);
-        p(&mut self.f, order);
-        p(&mut self.tau, order);
-        p(&mut self.eps_p, order);
-        p(&mut self.eps_p_rate, order);
-        p(&mut self.temperature, order);
-        p(&mut self.damage, order);
-        p(&mut self.pw, order);
-        p(&mut self.pw_zz, order);
-        p(&mut self.f_carry_slot, order);
-        p(&mut self.eroded, order);
     }
 }

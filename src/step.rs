@@ -628,6 +628,7 @@ impl Simulation {
                 damage: c.damage[k],
             };
             let new = mats[body as usize].update(&old, &StepKinematics { d: kin.d, w: kin.w, dt });
+            c.triaxiality_strain[k] += crate::material::strain_path_increment(&new.tau, new.eps_p - old.eps_p);
             let new = if fracturing { crate::material::fractured(new, J) } else { new };
             // Block-form kinematics keep a block-form stress (the models'
             // updates are sums and block products of `τ`, `d` and `w`).
@@ -669,6 +670,7 @@ impl Simulation {
             q.eps_p_rate.par_chunks_mut(piece),
             q.temperature.par_chunks_mut(piece),
             q.damage.par_chunks_mut(piece),
+            q.triaxiality_strain.par_chunks_mut(piece),
             q.pw.par_chunks_mut(piece),
             q.pw_zz.par_chunks_mut(piece),
             self.work_scratch.par_chunks_mut(piece),
@@ -677,25 +679,44 @@ impl Simulation {
         )
             .into_par_iter()
             .enumerate()
-            .map(|(i, (f, tau, eps_p, eps_p_rate, temperature, damage, pw, pw_zz, work, eroded, carry))| {
-                let mut c = PieceColumns {
-                    first: i * piece,
-                    f,
-                    tau,
-                    eps_p,
-                    eps_p_rate,
-                    temperature,
-                    damage,
-                    pw,
-                    pw_zz,
-                    work,
-                    eroded,
-                    carry,
-                    damping: 0.0,
-                };
-                let bad = (0..c.f.len()).find_map(|k| point(&mut c, k));
-                (bad, c.damping)
-            })
+            .map(
+                |(
+                    i,
+                    (
+                        f,
+                        tau,
+                        eps_p,
+                        eps_p_rate,
+                        temperature,
+                        damage,
+                        triaxiality_strain,
+                        pw,
+                        pw_zz,
+                        work,
+                        eroded,
+                        carry,
+                    ),
+                )| {
+                    let mut c = PieceColumns {
+                        first: i * piece,
+                        f,
+                        tau,
+                        eps_p,
+                        eps_p_rate,
+                        temperature,
+                        damage,
+                        triaxiality_strain,
+                        pw,
+                        pw_zz,
+                        work,
+                        eroded,
+                        carry,
+                        damping: 0.0,
+                    };
+                    let bad = (0..c.f.len()).find_map(|k| point(&mut c, k));
+                    (bad, c.damping)
+                },
+            )
             // The first inverted point in index order, the largest ratio.
             .reduce(|| (None, 0.0), |a, b| (a.0.or(b.0), a.1.max(b.1)));
         self.viscous_damping = damping;
@@ -843,6 +864,7 @@ struct PieceColumns<'a> {
     eps_p_rate: &'a mut [Real],
     temperature: &'a mut [Real],
     damage: &'a mut [Real],
+    triaxiality_strain: &'a mut [Real],
     pw: &'a mut [InPlane],
     pw_zz: &'a mut [Real],
     work: &'a mut [Real],

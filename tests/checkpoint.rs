@@ -399,19 +399,19 @@ fn checkpoint_of_another_format_version_is_refused_naming_both() {
     }
 }
 
-/// Format 10 (postcard, before the mass scaling's added mass) is
-/// refused, naming both versions, rather than misread.
+/// Format 11 (postcard, before the quadrature points' triaxiality over
+/// the strain path) is refused, naming both versions, rather than misread.
 #[test]
 fn older_format_version_checkpoint_is_refused_naming_both_versions() {
-    assert_eq!(FORMAT_VERSION, 11);
+    assert_eq!(FORMAT_VERSION, 12);
     let case = case(STRIKE, &["time.end=1e-6"]);
-    let dir = scratch("version-10");
+    let dir = scratch("version-11");
     let path = run_until(&case, &dir, 2);
-    corrupt(&path, 8, &10u32.to_le_bytes());
+    corrupt(&path, 8, &11u32.to_le_bytes());
     let e = checkpoint::read(&path).unwrap_err().to_string();
-    assert!(e.contains("format version 10 ") && e.contains("reads format version 11"), "{e}");
+    assert!(e.contains("format version 11 ") && e.contains("reads format version 12"), "{e}");
     let e = resume(&config(&dir, None), &mut |_| {}).unwrap_err().to_string();
-    assert!(e.contains("format version 10 ") && e.contains("format version 11"), "{e}");
+    assert!(e.contains("format version 11 ") && e.contains("format version 12"), "{e}");
 }
 
 #[test]

@@ -740,3 +740,37 @@ fn adiabatic_hardening_changes_sign_at_the_peak_of_the_driven_shear_curve() {
     assert!(peak.eps_p > 1.0 && peak.eps_p < 3.0, "peak at {}", peak.eps_p);
     assert!((onset.eps_p - peak.eps_p).abs() < 0.005 * peak.eps_p, "onset at {}, peak at {}", onset.eps_p, peak.eps_p);
 }
+
+/// `∫ η dε̄`, the triaxiality integrated over the plastic strain
+/// (`strain_path_increment`, the quadrature points' `triaxiality_strain`
+/// and the output field `average_triaxiality`): per step, the exact
+/// triaxialities of uniaxial tension (1/3), uniaxial compression (−1/3),
+/// pure shear and a pure pressure (0), and nothing without flow; over an
+/// elastic-plastic uniaxial-stress path (the driver's lateral stress
+/// iterated to zero), the path's own 1/3 and −1/3 to the lateral
+/// iteration's tolerance, the elastic start adding nothing.
+#[test]
+fn triaxiality_over_the_strain_path_averages_the_paths_own() {
+    use plugsim::material::strain_path_increment;
+    let diag = |a: f64, b: f64, c: f64| M3::from_diagonal(&nalgebra::Vector3::new(a, b, c));
+    let s = 7.0e8;
+    assert!(rel(strain_path_increment(&diag(s, 0.0, 0.0), 0.02), 0.02 / 3.0) < 1e-14);
+    assert!(rel(strain_path_increment(&diag(-s, 0.0, 0.0), 0.02), -0.02 / 3.0) < 1e-14);
+    assert_eq!(strain_path_increment(&diag(s, -s, 0.0), 0.02), 0.0);
+    assert_eq!(strain_path_increment(&diag(-s, -s, -s), 0.02), 0.0, "no deviator: no triaxiality");
+    assert_eq!(strain_path_increment(&diag(s, 0.0, 0.0), 0.0), 0.0, "no flow");
+    for (strain, want) in [(0.3, 1.0 / 3.0), (-0.3, -1.0 / 3.0)] {
+        let config = DriverConfig {
+            path: LoadPath::UniaxialStress,
+            rate: 1e3,
+            final_strain: strain,
+            dt: 0.3 / 1e3 / 3000.0,
+            initial_temperature: None,
+        };
+        let r = run(&Material::JohnsonCook(weldox_460e()), &config).unwrap();
+        let integral: f64 = r.windows(2).map(|p| strain_path_increment(&p[1].tau, p[1].eps_p - p[0].eps_p)).sum();
+        let eps = r.last().unwrap().eps_p;
+        assert!(eps > 0.25, "{eps}");
+        assert!((integral / eps - want).abs() < 1e-6, "{strain}: {}", integral / eps);
+    }
+}

@@ -51,6 +51,20 @@ fn fused_projection_has_the_bits_of_one_field_at_a_time() {
     // Hardening everywhere this early (the plate is far from its adiabatic
     // instability): finite and positive at every particle.
     assert!(array(&piece, "adiabatic_hardening").iter().all(|&h| h.is_finite() && h > 0.0));
+    // The path's average triaxiality: the ratio of the projections of
+    // `∫ η dε̄` and `ε̄`, 0 where nothing has flowed.
+    let (num, den) = (m.project(|k| q.triaxiality_strain[k]), m.project(|k| q.eps_p[k]));
+    let want = num.iter().zip(&den).map(|(n, d)| if *d > 0.0 { n / d } else { 0.0 });
+    let average = array(&piece, "average_triaxiality");
+    assert_eq!(bits(average.iter().cloned()), bits(want));
+    // Under the projectile the plate has flowed in the impact's compression:
+    // the most compressive path averages lie below Bao and Wierzbicki's
+    // cut-off, −1/3, and each stays within the bounds a triaxiality of a
+    // flowing point can take in this impact (a mean stress of a few GPa
+    // over a flow stress of about 1 GPa).
+    let least = average.iter().cloned().fold(0.0, f64::min);
+    assert!(least < -1.0 / 3.0 && least > -20.0, "{least}");
+    assert!(average.iter().all(|a| a.is_finite()));
 }
 
 #[test]

@@ -83,6 +83,29 @@ pub fn is_fractured(damage: Real) -> bool {
     damage >= 1.0
 }
 
+/// One step's share of `∫ η dε̄`, the stress triaxiality integrated over
+/// the plastic strain path ([`crate::quadrature::QuadraturePoints::triaxiality_strain`]):
+/// the end-of-step triaxiality `η = τ_m/τ̄` of the Kirchhoff stress `tau`
+/// (the ratio is the same for Cauchy's) times the step's plastic strain
+/// increment `d_eps`; zero where the point did not flow or carries no
+/// deviator. Divided by `ε̄` the sum is the average triaxiality of the
+/// strain path, the measure Bao and Wierzbicki's cut-off at `η = −1/3`
+/// is stated in (Bao & Wierzbicki 2005) and the one the Johnson–Cook
+/// locus is fitted with (its notched bars' triaxiality, averaged over the
+/// test); the damage itself integrates the locus at the current `η`.
+#[inline]
+pub fn strain_path_increment(tau: &Tensor3, d_eps: Real) -> Real {
+    if d_eps <= 0.0 {
+        return 0.0;
+    }
+    let tau_bar = crate::math::von_mises_2d(tau);
+    if tau_bar > 0.0 {
+        crate::math::mean_stress(tau) / tau_bar * d_eps
+    } else {
+        0.0
+    }
+}
+
 /// A point whose Johnson–Cook damage has reached 1 — fractured by the
 /// damage model's own measure — carries no shear and no tension, and
 /// carries pressure only while it is **closed**: its Kirchhoff stress is
