@@ -494,8 +494,12 @@ impl Model {
     /// solver's material update (without the carried jump).
     pub fn shape_deformation_gradient(&self, q: usize) -> Tensor3 {
         let u = &self.particles.u;
-        let (gu, _) = self.qp_shape.gradient_pair(q, u, u);
-        let uq = if self.mode.needs_point_values() { self.qp_shape.interpolate(q, u) } else { Vec2::zeros() };
+        let (gu, uq) = if self.mode.needs_point_values() {
+            let (gu, _, uq, _) = self.qp_shape.gradient_pair_and_values(q, u, u);
+            (gu, uq)
+        } else {
+            (self.qp_shape.gradient_pair(q, u, u).0, Vec2::zeros())
+        };
         self.mode.deformation_gradient(&gu, &uq, &self.quad.x0[q], 1.0)
     }
 

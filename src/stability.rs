@@ -61,9 +61,13 @@
 //! - **Mass scaling** (`[time] mass_scaling = f`, off by default; not in
 //!   SPEC §5 or \[RL10\]). On the fine rungs the step falls far below the
 //!   spacing step once cracks run: at 96 rows through the 12 mm plate from
-//!   10.8 ns to 2.5 ns by 60 µs, set by light crack-face children and
-//!   steep rows at the crack, a few particles out of 160,000; a held run
-//!   then takes hours. With `f`, every evaluation first adds mass to each
+//!   10.8 ns to 2.5 ns by 60 µs, set by a few particles out of 160,000:
+//!   crack-face children, and from 45 µs on a failed sliver of the
+//!   impact face between the rim crack and the projectile's edge, whose
+//!   points the punch shears at constant volume to a stretch of about 12
+//!   (its bound's own term 100 times its undeformed value;
+//!   `docs/performance.md`, "The fine rungs: what sets their step"); a
+//!   held run then takes hours. With `f`, every evaluation first adds mass to each
 //!   particle whose bound would take the elastic step below `f · Δt₀`,
 //!   as little as brings its bound to the target
 //!   ([`BoundScratch::scale_masses`]), as the common explicit codes do

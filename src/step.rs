@@ -586,11 +586,11 @@ impl Simulation {
             // (only read in axisymmetry). The 3x3 algebra works on the five
             // entries of the block form of 2D kinematics (`Block2`; same
             // bits as the general products).
-            let (gu, gv) = tab.gradient_pair(qi, u, v);
-            let (uq, vq) = if mode.needs_point_values() {
-                (tab.interpolate(qi, u), tab.interpolate(qi, v))
+            let (gu, gv, uq, vq) = if mode.needs_point_values() {
+                tab.gradient_pair_and_values(qi, u, v)
             } else {
-                (Vec2::zeros(), Vec2::zeros())
+                let (gu, gv) = tab.gradient_pair(qi, u, v);
+                (gu, gv, Vec2::zeros(), Vec2::zeros())
             };
             let F_dot = mode.deformation_gradient_2d(&gv, &vq, x0, 0.0);
             let mut F_new = mode.deformation_gradient_2d(&gu, &uq, x0, 1.0);
