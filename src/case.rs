@@ -1167,6 +1167,21 @@ fn validate_grid(add: &mut impl FnMut(String, String), key: &str, g: &RectangleG
             add(format!("{key}.refine_at"), format!("must lie in [x_min, x_max], got {x}"));
         }
     }
+    if let Some(x) = g.column_at {
+        let mut resolved = g.clone();
+        resolved.resolve(mode);
+        let x_f = resolved.refine_at.unwrap_or(g.x_min);
+        let d = (x - x_f).abs();
+        if !(x.is_finite() && d > 0.0 && d < g.fine_half_width && x > g.x_min && x < g.x_max) {
+            add(
+                format!("{key}.column_at"),
+                format!(
+                    "must lie inside the uniform fine zone (within fine_half_width = {} m of refine_at = {x_f} m, not at it) and inside the body, got {x}",
+                    g.fine_half_width
+                ),
+            );
+        }
+    }
 }
 
 /// One line from a TOML error: `line L, column C: message (`source

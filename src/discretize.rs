@@ -36,6 +36,20 @@ pub struct RectangleGrid {
     /// `(y_max − y_min)/(layers − 1)`, giving square cells under the projectile.
     #[serde(default)]
     pub fine_spacing: Option<Real>,
+    /// x of a particle column the fine zone is fitted to (m): the fine
+    /// spacing becomes `|column_at − refine_at| / n`, `n` the nearest whole
+    /// number of fine spacings (at least 1), so that a column falls on it
+    /// at every resolution ([`RectangleGrid::resolve`]; a change of the
+    /// spacing by at most half a spacing over the distance). For a plate
+    /// under a flat-nosed projectile: the projectile's radius, so that the
+    /// rim's crack can run through particles on the projectile's edge
+    /// instead of a fraction of a spacing inside or outside it, a fraction
+    /// that otherwise changes from one resolution to the next
+    /// (`docs/validation.md`, "A particle column on the projectile's
+    /// edge"). Must lie inside the fine zone, not at `refine_at`. Default:
+    /// none (the fine spacing as given).
+    #[serde(default)]
+    pub column_at: Option<Real>,
     /// Ratio between consecutive spacings outside the fine zone, ≥ 1.
     /// Default 1 (uniform).
     #[serde(default = "one")]
@@ -101,6 +115,7 @@ impl RectangleGrid {
             refine_at: None,
             fine_half_width: 0.0,
             fine_spacing: Some(h),
+            column_at: None,
             growth: 1.0,
             coarse_spacing: None,
             support_factor: 2.0,
@@ -122,9 +137,14 @@ impl RectangleGrid {
                 GeometryMode::PlaneStrain => 0.5 * (self.x_min + self.x_max),
             });
         }
-        if self.fine_spacing.is_none() {
-            self.fine_spacing = Some(self.layer_spacing());
-        }
+        let h = self.fine_spacing.unwrap_or_else(|| self.layer_spacing());
+        self.fine_spacing = Some(match (self.column_at, self.refine_at) {
+            (Some(x), Some(x_f)) if (x - x_f).abs() > 0.0 && h > 0.0 => {
+                let d = (x - x_f).abs();
+                d / (d / h).round().max(1.0)
+            }
+            _ => h,
+        });
     }
 
     /// Column x-coordinates: finest at `refine_at`, growing outward.
@@ -293,6 +313,7 @@ mod tests {
             refine_at: None,
             fine_half_width: half_width,
             fine_spacing: None,
+            column_at: None,
             growth,
             coarse_spacing: Some(coarse),
             support_factor: 2.0,
@@ -317,6 +338,41 @@ mod tests {
             assert!(gaps[k + 1] >= gaps[k] * (1.0 - 1e-9), "gap {k}");
         }
         assert!(gaps.iter().cloned().fold(0.0, Real::max) <= 0.004 * 1.5 + 1e-12);
+    }
+
+    /// `column_at`: a column on the given x at every resolution (both sides
+    /// in plane strain, the fine zone symmetric), the fine spacing moved by
+    /// at most half a spacing over the distance, resolving twice the same;
+    /// without it the thickness spacing as before.
+    #[test]
+    fn a_column_falls_on_column_at_at_every_resolution() {
+        for (mode, x_min) in [(GeometryMode::Axisymmetric, 0.0), (GeometryMode::PlaneStrain, -0.1)] {
+            for layers in [6, 12, 24, 36, 48, 72, 96] {
+                let mut g = RectangleGrid { x_min, column_at: Some(0.01), ..plate(layers, 0.02, 1.03, 0.004) };
+                let mut plain = RectangleGrid { x_min, ..plate(layers, 0.02, 1.03, 0.004) };
+                g.resolve(mode);
+                plain.resolve(mode);
+                let (h, h0) = (g.fine_spacing.unwrap(), plain.fine_spacing.unwrap());
+                assert_eq!(h0, g.layer_spacing(), "no column_at: the thickness spacing");
+                let n = 0.01 / h;
+                assert!(
+                    (n - n.round()).abs() < 1e-9 && (0.01 - n.round() * h0).abs() <= 0.5 * h0 + 1e-15,
+                    "{layers}: {h} vs {h0}"
+                );
+                let xs = g.columns();
+                let on = |x: Real| xs.iter().any(|c| (c - x).abs() < 1e-12);
+                assert!(on(0.01), "{mode:?} {layers} rows: no column at 0.01 m");
+                if mode == GeometryMode::PlaneStrain {
+                    assert!(on(-0.01), "{layers} rows: no column at -0.01 m");
+                }
+                let again = {
+                    let mut r = g.clone();
+                    r.resolve(mode);
+                    r.fine_spacing
+                };
+                assert_eq!(again, g.fine_spacing, "resolving twice");
+            }
+        }
     }
 
     #[test]

@@ -405,6 +405,7 @@ mod tests {
             refine_at: None,
             fine_half_width: half_width,
             fine_spacing: fine,
+            column_at: None,
             growth,
             coarse_spacing: coarse,
             support_factor: 2.0,

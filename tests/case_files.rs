@@ -198,3 +198,23 @@ fn mass_scaling_is_off_unless_asked_and_its_floor_is_checked() {
     let s = err_of(&with("end = 30.0e-6", "end = 30.0e-6\nmass_scaling = 0.5\nfixed_dt = 1.0e-9"));
     assert!(s.contains("time.mass_scaling") && s.contains("fixed_dt"), "{s}");
 }
+
+/// `column_at`: off unless asked; inside the fine zone it fits the fine
+/// spacing to a column on it (in the resolved case); outside the zone, at
+/// `refine_at` or outside the body it is refused, naming the key.
+#[test]
+fn a_column_at_the_projectiles_edge_is_checked() {
+    let text = BUILTIN_CASES.iter().find(|(n, _, _)| *n == "borvik-2-axisymmetric-nonlocal").unwrap().1;
+    let case = Case::from_str_with(text, "c2.toml", &[]).unwrap();
+    assert_eq!(case.bodies[0].rectangle.column_at, None);
+    let on = Case::from_str_with(text, "c2.toml", &["bodies.plate.rectangle.column_at=0.01".into()]).unwrap();
+    let r = &on.resolved().bodies[0].rectangle;
+    let h = r.fine_spacing.unwrap();
+    assert!((0.01 / h - (0.01 / h).round()).abs() < 1e-9 && (h / r.layer_spacing() - 1.0).abs() < 0.03, "{h}");
+    for bad in ["0.0", "0.03", "-0.01", "0.2"] {
+        let e = Case::from_str_with(text, "bad.toml", &[format!("bodies.plate.rectangle.column_at={bad}")])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("rectangle.column_at") && e.contains("fine zone"), "{bad}: {e}");
+    }
+}

@@ -23,6 +23,7 @@ fn rect(x: (Real, Real), y: (Real, Real), layers: usize, growth: Real) -> Rectan
         refine_at: None,
         fine_half_width: 0.0,
         fine_spacing: None,
+        column_at: None,
         growth,
         coarse_spacing: None,
         support_factor: 2.0,

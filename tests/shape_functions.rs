@@ -17,6 +17,7 @@ fn grid(growth: Real, support_factor: Real) -> RectangleGrid {
         refine_at: Some(0.004),
         fine_half_width: 0.005,
         fine_spacing: None,
+        column_at: None,
         growth,
         coarse_spacing: Some(0.004),
         support_factor,

@@ -38,6 +38,7 @@ fn plate(nx: usize, ny: usize) -> Model {
         refine_at: Some(0.0),
         fine_half_width: 1.0,
         fine_spacing: Some(h),
+        column_at: None,
         growth: 1.0,
         coarse_spacing: None,
         support_factor: 2.0,
