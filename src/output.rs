@@ -702,8 +702,9 @@ pub fn particle_piece(model: &Model, fields: &[String]) -> VtuPiece {
             }
         }
         if want(scalar_fields[last].0) {
-            // The ratio of the projections, as the crack gates read it
-            // (`CrackGrowth::triaxiality`); 0 where nothing has flowed.
+            // The ratio of the projections: the particle's points'
+            // `∫ η dε̄` over their `ε̄`, strain-weighted; 0 where nothing
+            // has flowed.
             let ratio = |r: &Row<PROJECTED>| {
                 let (num, den) = (r.0[5 + last], r.0[5 + eps_p]);
                 if den > 0.0 {

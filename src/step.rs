@@ -679,44 +679,26 @@ impl Simulation {
         )
             .into_par_iter()
             .enumerate()
-            .map(
-                |(
-                    i,
-                    (
-                        f,
-                        tau,
-                        eps_p,
-                        eps_p_rate,
-                        temperature,
-                        damage,
-                        triaxiality_strain,
-                        pw,
-                        pw_zz,
-                        work,
-                        eroded,
-                        carry,
-                    ),
-                )| {
-                    let mut c = PieceColumns {
-                        first: i * piece,
-                        f,
-                        tau,
-                        eps_p,
-                        eps_p_rate,
-                        temperature,
-                        damage,
-                        triaxiality_strain,
-                        pw,
-                        pw_zz,
-                        work,
-                        eroded,
-                        carry,
-                        damping: 0.0,
-                    };
-                    let bad = (0..c.f.len()).find_map(|k| point(&mut c, k));
-                    (bad, c.damping)
-                },
-            )
+            .map(|(i, (f, tau, eps_p, eps_p_rate, temperature, damage, path, pw, pw_zz, work, eroded, carry))| {
+                let mut c = PieceColumns {
+                    first: i * piece,
+                    f,
+                    tau,
+                    eps_p,
+                    eps_p_rate,
+                    temperature,
+                    damage,
+                    triaxiality_strain: path,
+                    pw,
+                    pw_zz,
+                    work,
+                    eroded,
+                    carry,
+                    damping: 0.0,
+                };
+                let bad = (0..c.f.len()).find_map(|k| point(&mut c, k));
+                (bad, c.damping)
+            })
             // The first inverted point in index order, the largest ratio.
             .reduce(|| (None, 0.0), |a, b| (a.0.or(b.0), a.1.max(b.1)));
         self.viscous_damping = damping;

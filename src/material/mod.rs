@@ -90,9 +90,8 @@ pub fn is_fractured(damage: Real) -> bool {
 /// increment `d_eps`; zero where the point did not flow or carries no
 /// deviator. Divided by `ε̄` the sum is the average triaxiality of the
 /// strain path, the measure Bao and Wierzbicki's cut-off at `η = −1/3`
-/// is stated in (Bao & Wierzbicki 2005) and the one the Johnson–Cook
-/// locus is fitted with (its notched bars' triaxiality, averaged over the
-/// test); the damage itself integrates the locus at the current `η`.
+/// is stated in (Bao & Wierzbicki 2005); the damage itself integrates
+/// the locus at the current `η`.
 #[inline]
 pub fn strain_path_increment(tau: &Tensor3, d_eps: Real) -> Real {
     if d_eps <= 0.0 {
