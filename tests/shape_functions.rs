@@ -25,6 +25,13 @@ fn grid(growth: Real, support_factor: Real) -> RectangleGrid {
     }
 }
 
+/// The particles and points of [`grid`], resolved and generated in `mode`.
+fn generated(growth: Real, support_factor: Real, mode: GeometryMode) -> plugsim::discretize::GeneratedBody {
+    let mut g = grid(growth, support_factor);
+    g.resolve(mode);
+    g.generate(mode)
+}
+
 /// Max relative violations of the reproducing conditions over all rows.
 fn check_reproduction(t: &ShapeTable, pts: &[Vec2], x0: &[Vec2], scale: Real) -> [Real; 6] {
     let mut worst = [0.0; 6];
@@ -58,9 +65,7 @@ fn check_reproduction(t: &ShapeTable, pts: &[Vec2], x0: &[Vec2], scale: Real) ->
 }
 
 fn reproduces(growth: Real) {
-    let mut g = grid(growth, 2.0);
-    g.resolve(GeometryMode::PlaneStrain);
-    let b = g.generate(GeometryMode::PlaneStrain);
+    let b = generated(growth, 2.0, GeometryMode::PlaneStrain);
     for pts in [&b.quad_points, &b.particles] {
         let t = build_table(pts, &b.particles, &b.support, &b.volume, &AllVisible).unwrap();
         let worst = check_reproduction(&t, pts, &b.particles, 0.06);
@@ -84,9 +89,7 @@ fn reproducing_conditions_graded() {
 
 #[test]
 fn gradients_match_finite_differences_of_values() {
-    let mut g = grid(1.2, 2.0);
-    g.resolve(GeometryMode::PlaneStrain);
-    let b = g.generate(GeometryMode::PlaneStrain);
+    let b = generated(1.2, 2.0, GeometryMode::PlaneStrain);
     let x = Vec2::new(0.0071, 0.0043);
     let h = 1e-7;
     let eval = |p: Vec2| build_table(&[p], &b.particles, &b.support, &b.volume, &AllVisible).unwrap();
@@ -110,9 +113,7 @@ fn gradients_match_finite_differences_of_values() {
 
 #[test]
 fn too_small_support_is_a_clear_error_not_nan() {
-    let mut g = grid(1.0, 0.55);
-    g.resolve(GeometryMode::PlaneStrain);
-    let b = g.generate(GeometryMode::PlaneStrain);
+    let b = generated(1.0, 0.55, GeometryMode::PlaneStrain);
     let err = build_table(&b.quad_points, &b.particles, &b.support, &b.volume, &AllVisible).unwrap_err();
     let ShapeError::SingularMoment { neighbours, .. } = err.clone();
     assert!(neighbours < 16);
@@ -125,9 +126,7 @@ fn too_small_support_is_a_clear_error_not_nan() {
 /// graded set, and the values reproduce a linear field.
 #[test]
 fn fused_gradients_and_values_have_the_bits_of_each_apart() {
-    let mut g = grid(1.2, 2.0);
-    g.resolve(GeometryMode::Axisymmetric);
-    let b = g.generate(GeometryMode::Axisymmetric);
+    let b = generated(1.2, 2.0, GeometryMode::Axisymmetric);
     let t = build_table(&b.quad_points, &b.particles, &b.support, &b.volume, &AllVisible).unwrap();
     // Two fields with no structure the sums could hide a reordering in.
     let field = |s: Real| -> Vec<Vec2> {
