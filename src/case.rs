@@ -1168,9 +1168,7 @@ fn validate_grid(add: &mut impl FnMut(String, String), key: &str, g: &RectangleG
         }
     }
     if let Some(x) = g.column_at {
-        let mut resolved = g.clone();
-        resolved.resolve(mode);
-        let x_f = resolved.refine_at.unwrap_or(g.x_min);
+        let x_f = g.refine_point(mode);
         let d = (x - x_f).abs();
         if !(x.is_finite() && d > 0.0 && d < g.fine_half_width && x > g.x_min && x < g.x_max) {
             add(

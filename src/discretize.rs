@@ -128,18 +128,23 @@ impl RectangleGrid {
         (self.y_max - self.y_min) / (self.layers as Real - 1.0)
     }
 
+    /// `refine_at`, or its default in `mode`: the middle, or the axis
+    /// (`x_min`) in axisymmetry.
+    pub fn refine_point(&self, mode: GeometryMode) -> Real {
+        self.refine_at.unwrap_or(match mode {
+            GeometryMode::Axisymmetric => self.x_min,
+            GeometryMode::PlaneStrain => 0.5 * (self.x_min + self.x_max),
+        })
+    }
+
     /// Fill in the defaults that depend on other fields, so that a resolved
     /// case file states every value used.
     pub fn resolve(&mut self, mode: GeometryMode) {
-        if self.refine_at.is_none() {
-            self.refine_at = Some(match mode {
-                GeometryMode::Axisymmetric => self.x_min,
-                GeometryMode::PlaneStrain => 0.5 * (self.x_min + self.x_max),
-            });
-        }
+        let x_f = self.refine_point(mode);
+        self.refine_at = Some(x_f);
         let h = self.fine_spacing.unwrap_or_else(|| self.layer_spacing());
-        self.fine_spacing = Some(match (self.column_at, self.refine_at) {
-            (Some(x), Some(x_f)) if (x - x_f).abs() > 0.0 && h > 0.0 => {
+        self.fine_spacing = Some(match self.column_at {
+            Some(x) if (x - x_f).abs() > 0.0 && h > 0.0 => {
                 let d = (x - x_f).abs();
                 d / (d / h).round().max(1.0)
             }
