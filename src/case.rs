@@ -432,6 +432,15 @@ pub struct TimeSpec {
     /// (no `fixed_dt`).
     #[serde(default)]
     pub mass_scaling: Option<Real>,
+    /// Erosion at the step's floor, a fraction of the spacing step `Δt₀`
+    /// in (0, 1]: a fractured point (`D ≥ 1`, carrying pressure only)
+    /// whose distortion would take the step below this fraction of `Δt₀`
+    /// is eroded, as the explicit codes erode a failed element at a
+    /// minimum step ([`crate::stability`]). A deviation from SPEC §5, off
+    /// when absent; the run reports the points eroded. Needs the adaptive
+    /// step (no `fixed_dt`) and a fracture criterion whose points fail.
+    #[serde(default)]
+    pub erode_failed_below: Option<Real>,
 }
 
 fn half() -> Real {
@@ -779,18 +788,24 @@ impl Case {
         for (key, message) in self.time.bulk_viscosity.map_or(Vec::new(), |b| b.problems()) {
             add(format!("time.bulk_viscosity.{key}"), message);
         }
-        if let Some(f) = self.time.mass_scaling {
+        // The step's floors: a fraction of the spacing step, with the adaptive step.
+        for (key, floor) in
+            [("mass_scaling", self.time.mass_scaling), ("erode_failed_below", self.time.erode_failed_below)]
+        {
+            let Some(f) = floor else { continue };
             if !(f > 0.0 && f <= 1.0) {
-                add(
-                    "time.mass_scaling".into(),
-                    format!("must lie in (0, 1] (a fraction of the spacing step), got {f}"),
-                );
+                add(format!("time.{key}"), format!("must lie in (0, 1] (a fraction of the spacing step), got {f}"));
             } else if self.time.fixed_dt.is_some() {
-                add(
-                    "time.mass_scaling".into(),
-                    "needs the adaptive step: leave out time.fixed_dt, or mass_scaling".into(),
-                );
+                add(format!("time.{key}"), format!("needs the adaptive step: leave out time.fixed_dt, or {key}"));
             }
+        }
+        if self.time.erode_failed_below.is_some() && !self.fracture.fractures_points() {
+            add(
+                "time.erode_failed_below".into(),
+                "erodes fractured points, and this fracture criterion fractures none (fracture.criterion \
+                 \"none\", or \"nonlocal_damage\" with nonlocal_point_fracture = false)"
+                    .into(),
+            );
         }
         if let Some(dt) = self.time.fixed_dt {
             positive(&mut add, "time.fixed_dt", dt, "s");
@@ -885,12 +900,14 @@ impl Case {
 
     /// Set on `sim` what a run takes from this case and checkpoints do not
     /// store: heat conduction ([`Case::heat_conduction_for`]), the bulk
-    /// viscosity and mass scaling. The one place for both a fresh run at
+    /// viscosity, mass scaling and erosion at the step's floor. The one
+    /// place for both a fresh run at
     /// t = 0 and a run resumed from a checkpoint.
     pub fn apply_unstored_settings(&self, sim: &mut crate::step::Simulation) -> Result<(), crate::thermal::HeatError> {
         sim.heat = self.heat_conduction_for(&sim.model)?;
         sim.bulk_viscosity = self.bulk_viscosity();
         sim.mass_scaling = self.time.mass_scaling;
+        sim.erode_failed_below = self.time.erode_failed_below;
         Ok(())
     }
 

@@ -60,7 +60,8 @@
 //! events' own damage, [`crate::fracture::CrackEvent::damage`]; 9 their
 //! adiabatic hardening; 10 the quadrature points' cell length; 11 the mass
 //! scaling's added mass and its account; 12 the quadrature points'
-//! triaxiality integrated over the plastic strain). The payload is
+//! triaxiality integrated over the plastic strain; 13 the count of points
+//! eroded at the step's floor). The payload is
 //! [postcard](https://docs.rs/postcard) 1.x, whose wire format is stable
 //! within the major version: fields in declaration order, no names; an
 //! `f64` as its eight IEEE-754 bytes, so values (NaN payloads, −0.0)
@@ -142,8 +143,10 @@ pub const MAGIC: [u8; 8] = *b"PLUGCKPT";
 /// ([`crate::particles::Particles::added_mass`],
 /// [`crate::stability::AddedMass`], [`crate::step::Energies::mass_scaling`]),
 /// version 12 the quadrature points' triaxiality integrated over the
-/// plastic strain ([`crate::quadrature::QuadraturePoints::triaxiality_strain`]).
-pub const FORMAT_VERSION: u32 = 12;
+/// plastic strain ([`crate::quadrature::QuadraturePoints::triaxiality_strain`]),
+/// version 13 the count of points eroded at the step's floor
+/// ([`crate::stability::StableStep::eroded`]).
+pub const FORMAT_VERSION: u32 = 13;
 /// Subdirectory of a run's output directory that holds its checkpoints.
 pub const DIRECTORY: &str = "checkpoints";
 /// File name extension of a checkpoint.

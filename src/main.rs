@@ -1117,8 +1117,13 @@ fn drive(
     }
     if s.eroded_points > 0 {
         println!(
-            "  eroded: {} quadrature points inverted after meeting the crack criterion, or were torn open after fracturing, and carry no stress (history.csv: eroded_points)",
+            "  eroded: {} quadrature points inverted after meeting the crack criterion, were torn open after fracturing, or were eroded at the step's floor, and carry no stress (history.csv: eroded_points)",
             s.eroded_points
+        );
+    }
+    if let Some(n) = s.floor_eroded {
+        println!(
+            "  erosion at the step's floor (time.erode_failed_below, not in SPEC §5): {n} fractured points eroded, of those above"
         );
     }
     match s.exposed.contacts {

@@ -59,8 +59,10 @@ pub struct QuadraturePoints {
     /// The carried jumps, one per point that has one (few: the points next
     /// to crack paths).
     pub f_carry: Vec<Tensor3>,
-    /// Eroded: the point inverted after meeting the crack criterion, or
-    /// was torn open after fracturing (`crate::material::TORN_VOLUME_RATIO`), and
+    /// Eroded: the point inverted after meeting the crack criterion, was
+    /// torn open after fracturing (`crate::material::TORN_VOLUME_RATIO`),
+    /// or, fractured, would have set the stable step below the case's
+    /// floor (`[time] erode_failed_below`, [`crate::stability`]), and
     /// carries no stress from then on (`crate::fracture` module doc).
     pub eroded: Vec<bool>,
 }
@@ -132,6 +134,17 @@ impl QuadraturePoints {
         self.pw_zz.push(pw.zz);
         self.f_carry_slot.push(NO_CARRY);
         self.eroded.push(false);
+    }
+
+    /// Erode point `q`: it carries no stress (and so no internal force) from
+    /// now on; its state stays for the output and the criteria
+    /// ([`QuadraturePoints::eroded`]).
+    pub fn erode(&mut self, q: usize) {
+        self.eroded[q] = true;
+        self.tau[q] = Block2::zeros();
+        let pw = Block2::zeros();
+        self.pw[q] = pw.in_plane();
+        self.pw_zz[q] = pw.zz;
     }
 
     /// Add `jump` to the deformation gradient carried by point `q`.

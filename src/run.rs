@@ -127,9 +127,13 @@ pub struct RunSummary {
     /// The plug at the end of the run, if the cracks cut one out under the
     /// first rigid body ([`crate::plug`]).
     pub plug: Option<crate::plug::Plug>,
-    /// Quadrature points eroded by the end (inverted after failing,
-    /// [`crate::fracture`]).
+    /// Quadrature points eroded by the end (inverted after failing, torn
+    /// open, or at the step's floor; [`crate::fracture`]).
     pub eroded_points: usize,
+    /// Of those, the fractured points eroded at the step's floor
+    /// (`[time] erode_failed_below`, [`crate::stability::StableStep::eroded`]);
+    /// `None` without it.
+    pub floor_eroded: Option<u64>,
     /// Particles that joined the contact slaves by exposure, and when they
     /// touched a rigid body ([`crate::contact::ContactSystem::admit_exposed`]).
     pub exposed: crate::output::ExposedSummary,
@@ -551,6 +555,7 @@ fn time_loop(
         perforation,
         plug,
         eroded_points: sim.model.quad.eroded.iter().filter(|&&e| e).count(),
+        floor_eroded: sim.erode_failed_below.and(sim.stable.as_ref()).map(|s| s.eroded),
         exposed: crate::output::exposed_contact_summary(&history),
         cracks,
         tip_damage,

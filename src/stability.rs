@@ -84,6 +84,25 @@
 //!   (the step, the mass only where needed, momentum, the energy account,
 //!   and the exact highest frequency of the scaled system),
 //!   `splits_keep_the_mass_that_mass_scaling_added` (`tests/fracture.rs`).
+//! - **Erosion at the step's floor** (`[time] erode_failed_below = f`,
+//!   off by default; not in SPEC §5 or \[RL10\]). Mass scaling treats the
+//!   failed sliver above as it treats a light particle, by slowing it
+//!   down. The other remedy of the explicit codes is to remove a failed
+//!   element whose step falls below a floor (LS-DYNA's erosion at a
+//!   minimum step). With `f`, every evaluation first erodes fractured
+//!   points (`D ≥ 1` while cracks grow, pressure only,
+//!   [`crate::material::fractured`]) that take a particle's bound above
+//!   the floor's target `(ω_ref / f)²`, as few as bring it there, largest
+//!   term first ([`BoundScratch::erode_failed`]); an eroded point carries
+//!   no stress from then on ([`crate::quadrature::QuadraturePoints::erode`]),
+//!   its particles keep their mass. Intact or merely damaged points are
+//!   never eroded: where they set the step it falls as before. What it
+//!   removes is the pressure a crushed, failed crumb still carries, so it
+//!   is an option whose effect is measured (`docs/performance.md`), not the
+//!   default. Test: `erosion_at_the_floor_removes_a_failed_sliver_and_only_it`
+//!   (the sliver makes the spacing step unstable by the exact highest
+//!   frequency; after erosion the step keeps half the stability limit;
+//!   intact, damaged and mildly sheared fractured points stay).
 
 use crate::bulk_viscosity::step_factor;
 use crate::material::{Constitutive, Material};
@@ -105,6 +124,14 @@ fn column_norm(grad: &Vec2, n: Real, f_inv: Option<&Block2>, hoop: Option<Real>)
     };
     let hoop_entry = hoop.map_or(0.0, |r| h * n / r);
     (g.norm_squared() + hoop_entry * hoop_entry).sqrt()
+}
+
+/// The entries of point `q`'s piece of [`BoundScratch::entries`], and the
+/// table index of the piece's first entry (entry `k` of `q` is at `k −
+/// first`).
+#[inline]
+fn piece<'a>(entries: &'a [Vec<Real>], offsets: &[usize], q: usize) -> (&'a [Real], usize) {
+    (&entries[q / PARALLEL_PIECE], offsets[q - q % PARALLEL_PIECE])
 }
 
 /// Gershgorin bound `ω_I²` of every particle (module doc), rad²/s², in the
@@ -210,12 +237,20 @@ impl BoundScratch {
             for j in gather.range(i) {
                 let (k, q) = (gather.entry[j] as usize, gather.point[j] as usize);
                 if row_factor[q] != 0.0 {
-                    let q0 = q - q % PARALLEL_PIECE;
-                    sum += entries[q / PARALLEL_PIECE][k - table.offsets[q0]] * row_factor[q];
+                    let (entries, first) = piece(entries, &table.offsets, q);
+                    sum += entries[k - first] * row_factor[q];
                 }
             }
             *bound = sum;
         });
+    }
+
+    /// The particles whose bound exceeds `target`, stiffest first (ties by
+    /// index): the order both floors take them in.
+    fn stiffest_over(&self, target: Real) -> Vec<usize> {
+        let mut over: Vec<usize> = (0..self.bounds.len()).filter(|&i| self.bounds[i] > target).collect();
+        over.sort_by(|&a, &b| self.bounds[b].total_cmp(&self.bounds[a]).then(a.cmp(&b)));
+        over
     }
 
     /// Mass scaling: the factors `m_new / m_I` (> 1) that bring every
@@ -234,11 +269,10 @@ impl BoundScratch {
     /// particle the ones before it brought down gets no mass, and no bound
     /// rises: afterwards every bound is at most `target` (to round-off).
     pub fn scale_masses(&self, model: &Model, target: Real) -> Vec<(usize, Real)> {
-        let mut over: Vec<usize> = (0..self.bounds.len()).filter(|&i| self.bounds[i] > target).collect();
+        let over = self.stiffest_over(target);
         if over.is_empty() {
             return Vec::new();
         }
-        over.sort_by(|&a, &b| self.bounds[b].total_cmp(&self.bounds[a]).then(a.cmp(&b)));
         let (table, gather) = (&model.qp_shape, &model.gather);
         // `1/√s_J` of the particles scaled so far.
         let mut shrink: std::collections::HashMap<usize, Real> = std::collections::HashMap::new();
@@ -251,8 +285,7 @@ impl BoundScratch {
                 if self.row_factor[q] == 0.0 || modulus_w == 0.0 {
                     continue;
                 }
-                let q0 = q - q % PARALLEL_PIECE;
-                let (entries, first) = (&self.entries[q / PARALLEL_PIECE], table.offsets[q0]);
+                let (entries, first) = piece(&self.entries, &table.offsets, q);
                 let factor = |k: usize| shrink.get(&(table.index[k] as usize)).copied().unwrap_or(1.0);
                 let e_i = entries[k - first] * factor(k);
                 let rest: Real = table.range(q).filter(|&m| m != k).map(|m| entries[m - first] * factor(m)).sum();
@@ -271,6 +304,49 @@ impl BoundScratch {
             scaled.push(i);
         }
         scaled.into_iter().map(|i| (i, 1.0 / shrink[&i].powi(2))).collect()
+    }
+
+    /// Erosion at the step's floor: the points to erode so that every
+    /// particle's bound ([`BoundScratch::bounds`], as filled for `model`)
+    /// falls to `target`, taken only among the points `failed` admits (and
+    /// that still carry stress).
+    ///
+    /// A particle's bound is the sum of its points' terms,
+    /// `ω_I² = Σ_q c_Iq`, `c_Iq = k_q w_q (|b_I(q)|/√m_I) Σ_J |b_J(q)|/√m_J`;
+    /// an eroded point's `k_q` is 0, so eroding `q` takes its `c_Iq` off
+    /// every particle it reaches and raises no bound. The particles above
+    /// the target are taken stiffest first (ties by index), each with the
+    /// points eroded before it left out; each erodes its admitted points,
+    /// largest term first (ties by index), until its bound is at most the
+    /// target or none is left. Returns the points in increasing order.
+    pub fn erode_failed(&self, model: &Model, target: Real, failed: impl Fn(usize) -> bool) -> Vec<usize> {
+        let over = self.stiffest_over(target);
+        let (table, gather) = (&model.qp_shape, &model.gather);
+        let mut eroded = std::collections::BTreeSet::new();
+        for i in over {
+            let (mut bound, mut admitted) = (0.0, Vec::new());
+            for j in gather.range(i) {
+                let (k, q) = (gather.entry[j] as usize, gather.point[j] as usize);
+                if self.row_factor[q] == 0.0 || eroded.contains(&q) {
+                    continue;
+                }
+                let (entries, first) = piece(&self.entries, &table.offsets, q);
+                let term = entries[k - first] * self.row_factor[q];
+                bound += term;
+                if failed(q) {
+                    admitted.push((term, q));
+                }
+            }
+            admitted.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+            for (term, q) in admitted {
+                if bound <= target {
+                    break;
+                }
+                eroded.insert(q);
+                bound -= term;
+            }
+        }
+        eroded.into_iter().collect()
     }
 }
 
@@ -327,9 +403,22 @@ pub struct StableStep {
     /// [`crate::step::Energies::mass_scaling`], the mass per particle in
     /// [`crate::particles::Particles::added_mass`]).
     pub added: AddedMass,
+    /// Fractured points eroded at the step's floor so far
+    /// ([`StableStep::evaluate`] with an erosion floor).
+    pub eroded: u64,
     /// Not in checkpoints: rewritten by every evaluation.
     #[serde(skip)]
     scratch: BoundScratch,
+}
+
+/// The floors of the stable step ([`StableStep::evaluate`]), each a
+/// fraction of the rule's step `Δt₀` in (0, 1], or none.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Floors {
+    /// Mass scaling (`[time] mass_scaling`).
+    pub mass_scaling: Option<Real>,
+    /// Erosion of fractured points (`[time] erode_failed_below`).
+    pub erosion: Option<Real>,
 }
 
 /// The running account of mass scaling ([`StableStep::evaluate`]).
@@ -361,6 +450,7 @@ impl StableStep {
             every: EVALUATE_EVERY,
             smallest: (base, 0.0, i),
             added: AddedMass::default(),
+            eroded: 0,
             scratch: BoundScratch::default(),
         }
     }
@@ -376,15 +466,34 @@ impl StableStep {
     /// at rest: its velocity drops so that its momentum stays, and the
     /// kinetic energy this takes out is returned (J; 0 without mass
     /// added), for the energy account.
+    ///
+    /// With `floors.erosion` (`[time] erode_failed_below`) and `fracturing`,
+    /// before that, the fractured points (`D ≥ 1`) that would take the
+    /// elastic step below `floors.erosion · Δt₀` are eroded, as few as
+    /// bring every bound they reach to that floor
+    /// ([`BoundScratch::erode_failed`]).
     pub fn evaluate(
         &mut self,
         model: &mut Model,
         time: Real,
         fracturing: bool,
         damping_ratio: Real,
-        mass_floor: Option<Real>,
+        floors: Floors,
     ) -> (Real, Real) {
         self.scratch.fill(model, true, fracturing);
+        if let Some(floor) = floors.erosion.filter(|_| fracturing) {
+            let quad = &model.quad;
+            let failed = |q: usize| crate::material::is_fractured(quad.damage[q]);
+            let points = self.scratch.erode_failed(model, (self.reference / floor).powi(2), failed);
+            if !points.is_empty() {
+                for &q in &points {
+                    model.quad.erode(q);
+                }
+                self.eroded += points.len() as u64;
+                self.scratch.fill(model, true, fracturing);
+            }
+        }
+        let mass_floor = floors.mass_scaling;
         let mut removed = 0.0;
         if let Some(floor) = mass_floor {
             let target = (self.reference / floor).powi(2);

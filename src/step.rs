@@ -10,7 +10,7 @@ use crate::math::{is_block_2d, Block2, InPlane, Real, Tensor3, Vec2};
 use crate::model::{constrain, Model, PARALLEL_PIECE};
 use crate::particles::ParticleFlags;
 use crate::quadrature::NO_CARRY;
-use crate::stability::StableStep;
+use crate::stability::{Floors, StableStep};
 use crate::thermal::{HeatConduction, HeatError};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -263,6 +263,13 @@ pub struct Simulation {
     /// checkpoints: set from the case, as `bulk_viscosity`.
     #[serde(skip)]
     pub mass_scaling: Option<Real>,
+    /// Erosion at the step's floor: fractured points that would take the
+    /// elastic step below this fraction of `Δt₀` are eroded
+    /// ([`crate::stability::StableStep::evaluate`]; `[time]
+    /// erode_failed_below`); `None`: none is (SPEC §5). Not in
+    /// checkpoints: set from the case, as `mass_scaling`.
+    #[serde(skip)]
+    pub erode_failed_below: Option<Real>,
     /// Per-point internal-energy increments of the last step (scratch; this
     /// and `kinetic_scratch` are not in checkpoints: each step resizes and
     /// rewrites them before reading them).
@@ -309,6 +316,7 @@ impl Simulation {
             stable,
             dt_previous: dt,
             mass_scaling: None,
+            erode_failed_below: None,
             model,
             time: 0.0,
             step: 0,
@@ -437,8 +445,8 @@ impl Simulation {
             return;
         };
         let fracturing = self.cracks.as_ref().is_some_and(|c| c.params.fractures_points());
-        let (dt, removed) =
-            stable.evaluate(&mut self.model, self.time, fracturing, self.viscous_damping, self.mass_scaling);
+        let floors = Floors { mass_scaling: self.mass_scaling, erosion: self.erode_failed_below };
+        let (dt, removed) = stable.evaluate(&mut self.model, self.time, fracturing, self.viscous_damping, floors);
         self.energies.mass_scaling += removed;
         self.dt = dt;
     }

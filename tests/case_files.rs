@@ -185,18 +185,29 @@ fn bulk_viscosity_is_off_unless_asked_and_its_coefficients_are_checked() {
     assert!(s.contains("linaer"), "{s}");
 }
 
+/// The step's floors, mass scaling and erosion at the floor: off unless
+/// asked; a value outside (0, 1], or with a fixed step, is refused naming
+/// the key; erosion also with a criterion that fractures no point.
 #[test]
-fn mass_scaling_is_off_unless_asked_and_its_floor_is_checked() {
-    let case = Case::from_str_with(GOOD, "good.toml", &[]).unwrap();
-    assert_eq!(case.time.mass_scaling, None);
-    let on = with("end = 30.0e-6", "end = 30.0e-6\nmass_scaling = 0.5");
-    assert_eq!(Case::from_str_with(&on, "good.toml", &[]).unwrap().time.mass_scaling, Some(0.5));
-    for bad in ["0.0", "1.5", "-0.2"] {
-        let s = err_of(&with("end = 30.0e-6", &format!("end = 30.0e-6\nmass_scaling = {bad}")));
-        assert!(s.contains("time.mass_scaling") && s.contains("(0, 1]"), "{s}");
+fn the_steps_floors_are_off_unless_asked_and_checked() {
+    let text = BUILTIN_CASES.iter().find(|(n, _, _)| *n == "borvik-2-axisymmetric-nonlocal").unwrap().1;
+    let parse = |sets: &[String]| Case::from_str_with(text, "c2.toml", sets);
+    let time = parse(&[]).unwrap().time;
+    assert_eq!((time.mass_scaling, time.erode_failed_below), (None, None));
+    for key in ["mass_scaling", "erode_failed_below"] {
+        let time = parse(&[format!("time.{key}=0.5")]).unwrap().time;
+        assert_eq!(if key == "mass_scaling" { time.mass_scaling } else { time.erode_failed_below }, Some(0.5));
+        for bad in ["0.0", "1.5", "-0.2"] {
+            let e = parse(&[format!("time.{key}={bad}")]).unwrap_err().to_string();
+            assert!(e.contains(&format!("time.{key}")) && e.contains("(0, 1]"), "{e}");
+        }
+        let e = parse(&[format!("time.{key}=0.5"), "time.fixed_dt=1e-9".into()]).unwrap_err().to_string();
+        assert!(e.contains(&format!("time.{key}")) && e.contains("fixed_dt"), "{e}");
     }
-    let s = err_of(&with("end = 30.0e-6", "end = 30.0e-6\nmass_scaling = 0.5\nfixed_dt = 1.0e-9"));
-    assert!(s.contains("time.mass_scaling") && s.contains("fixed_dt"), "{s}");
+    for set in ["fracture.criterion=\"none\"", "fracture.nonlocal_point_fracture=false"] {
+        let e = parse(&["time.erode_failed_below=0.5".into(), set.into()]).unwrap_err().to_string();
+        assert!(e.contains("time.erode_failed_below") && e.contains("fractures none"), "{set}: {e}");
+    }
 }
 
 /// `column_at`: off unless asked; inside the fine zone it fits the fine

@@ -9,7 +9,7 @@ use plugsim::geometry::GeometryMode;
 use plugsim::material::{Elastic, Material};
 use plugsim::math::{Block2, Real, Vec2};
 use plugsim::model::{BodySetup, Model};
-use plugsim::stability::{frequency_bounds, stiffest_particle};
+use plugsim::stability::{frequency_bounds, stiffest_particle, Floors, StableStep};
 use plugsim::step::{Simulation, TimeStepRule};
 
 const E: Real = 200e9;
@@ -53,13 +53,25 @@ fn plate(nx: usize, ny: usize) -> Model {
 /// independently of the solver: `K = Σ_q B_qᵀ D B_q w_q` with the spatial
 /// gradients `F_q⁻ᵀ ∇_X N_I` in `B` and the isotropic elastic moduli `D`,
 /// `M` the lumped masses; the largest eigenvalue of `M^{-1/2} K M^{-1/2}`.
+///
+/// A point fractured by its damage (`D ≥ 1`) and closed (`J < 1`) resists
+/// only a change of volume, with the bulk modulus `K` (it carries pressure
+/// only); an eroded point adds nothing.
 fn exact_highest_frequency(model: &Model) -> Real {
     let n = model.particles.len();
     let (lambda, mu) = (E * NU / ((1.0 + NU) * (1.0 - 2.0 * NU)), E / (2.0 * (1.0 + NU)));
-    let d = nalgebra::Matrix3::new(lambda + 2.0 * mu, lambda, 0.0, lambda, lambda + 2.0 * mu, 0.0, 0.0, 0.0, mu);
+    let intact = nalgebra::Matrix3::new(lambda + 2.0 * mu, lambda, 0.0, lambda, lambda + 2.0 * mu, 0.0, 0.0, 0.0, mu);
+    let k_bulk = E / (3.0 * (1.0 - 2.0 * NU));
+    let pressure_only = nalgebra::Matrix3::new(k_bulk, k_bulk, 0.0, k_bulk, k_bulk, 0.0, 0.0, 0.0, 0.0);
     let mut k = DMatrix::<Real>::zeros(2 * n, 2 * n);
     let table = &model.qp_shape;
     for q in 0..model.quad.len() {
+        let d = match (model.quad.eroded[q], model.quad.damage[q] >= 1.0) {
+            (true, _) => continue,
+            (false, true) if model.quad.f[q].determinant() < 1.0 => pressure_only,
+            (false, true) => continue,
+            (false, false) => intact,
+        };
         let fi = model.quad.f[q].try_inverse().unwrap();
         let cols: Vec<(usize, nalgebra::Matrix3x2<Real>)> = table
             .range(q)
@@ -295,4 +307,83 @@ fn mass_scaling_holds_the_step_at_its_floor_and_keeps_the_margin() {
     }
     assert!(largest < 0.02, "energy drift {largest} with mass scaling");
     assert!(sim.dt >= 0.5 * dt0 * (1.0 - 1e-9));
+}
+
+/// A failed sliver: the quadrature points of a few cells fractured by
+/// their damage (`D ≥ 1`, pressure only) and sheared at nearly constant volume to a stretch of
+/// about 12, as the punch shears the impact face's sliver between a rim
+/// crack and the projectile's edge at 96 rows (`docs/performance.md`,
+/// "The fine rungs: what sets their step"). It alone takes the step far
+/// below the spacing step. With the erosion floor at half the spacing step
+/// some of those points, and no other, are eroded; the step is the spacing step again,
+/// and the exact highest frequency of the system (assembled independently,
+/// the fractured points at their bulk modulus) confirms both: with the
+/// sliver the spacing step is unstable (`ω Δt₀ > 2`), after erosion the
+/// step keeps half the stability limit (`ω Δt < 1`; 0.80 on the reference
+/// lattice). The same distortion at an intact point, or at a
+/// point short of fracture (`D = 0.9`), erodes nothing; a mildly sheared
+/// fractured point (stretch 1.3) is left alone, as it does not take the
+/// step below the floor; without the floor nothing is eroded.
+#[test]
+fn erosion_at_the_floor_removes_a_failed_sliver_and_only_it() {
+    let reference = plate(9, 6);
+    let dt0 = 0.5 * reference.min_spacing() / reference.max_wave_speed();
+    let margin0 = exact_highest_frequency(&reference) * dt0;
+    // The sliver: the points of the cells around the plate's middle.
+    let middle = Vec2::new(4e-3, 2.5e-3);
+    let sliver: Vec<usize> =
+        (0..reference.quad.len()).filter(|&p| (reference.quad.x0[p] - middle).norm() < 0.8e-3).collect();
+    assert!(sliver.len() >= 4, "{sliver:?}");
+    // Simple shear by γ at volume ratio J.
+    let sheared = |gamma: Real, j: Real| {
+        let s = j.sqrt();
+        Block2 { xx: s, xy: s * gamma, yx: 0.0, yy: s, zz: 1.0 }
+    };
+    let evaluate = |damage: Real, gamma: Real, floor: Option<Real>| {
+        let mut model = plate(9, 6);
+        for &q in &sliver {
+            model.quad.f[q] = sheared(gamma, 0.99);
+            model.quad.damage[q] = damage;
+        }
+        let mut stable = StableStep::new(&model, dt0);
+        let floors = Floors { erosion: floor, ..Floors::default() };
+        let (dt, removed) = stable.evaluate(&mut model, 0.0, true, 0.0, floors);
+        assert_eq!(removed, 0.0);
+        (model, stable, dt)
+    };
+    // Without the floor the sliver takes the step down.
+    let (model, stable, dt) = evaluate(1.5, 12.0, None);
+    assert_eq!((stable.eroded, model.quad.eroded.iter().filter(|&&e| e).count()), (0, 0));
+    let with_sliver = exact_highest_frequency(&model) * dt0;
+    assert!(dt < 0.5 * dt0, "the sliver's step {} of the spacing step's", dt / dt0);
+    assert!(with_sliver > 2.0 * margin0, "exact ω Δt₀ {with_sliver:.3} against {margin0:.3}");
+    // With it, only the sliver's points go, and the step comes back.
+    let (model, stable, dt) = evaluate(1.5, 12.0, Some(0.5));
+    let eroded: Vec<usize> = (0..model.quad.len()).filter(|&p| model.quad.eroded[p]).collect();
+    assert!(!eroded.is_empty() && eroded.iter().all(|p| sliver.contains(p)), "eroded {eroded:?} of {sliver:?}");
+    assert_eq!(stable.eroded, eroded.len() as u64);
+    assert!(eroded.iter().all(|&p| model.quad.tau[p] == Block2::zeros() && model.quad.pw_zz[p] == 0.0));
+    assert!(dt >= 0.5 * dt0, "the step {} of the spacing step's after erosion", dt / dt0);
+    let margin = exact_highest_frequency(&model) * dt;
+    eprintln!(
+        "sliver: {} of {} points eroded; exact ω Δt₀ {with_sliver:.3} with it, ω Δt {margin:.3} after erosion (reference {margin0:.3}); step {:.3} Δt₀",
+        eroded.len(),
+        sliver.len(),
+        dt / dt0
+    );
+    // The central difference is stable below ω Δt = 2; the spacing step
+    // keeps 0.80 on the reference lattice, and the step after erosion (its
+    // bound at or under the floor's target, the bound as loose as a
+    // lattice's) keeps half the limit.
+    assert!(with_sliver > 2.0 && margin < 1.0, "ω Δt = {margin:.3} against {margin0:.3} on the reference lattice");
+    // What the floor does not erode: intact or merely damaged points at the
+    // same distortion, and a fractured point the step tolerates.
+    for (damage, gamma) in [(0.0, 12.0), (0.9, 12.0), (1.5, 1.3)] {
+        let (model, stable, dt) = evaluate(damage, gamma, Some(0.5));
+        assert!(model.quad.eroded.iter().all(|&e| !e), "D = {damage}, γ = {gamma}: a point eroded");
+        assert_eq!(stable.eroded, 0);
+        if damage < 1.0 {
+            assert!(dt < 0.5 * dt0, "D = {damage}: the step {} of the spacing step's", dt / dt0);
+        }
+    }
 }
