@@ -407,6 +407,10 @@ pub struct Shot {
     /// `[time] mass_scaling`).
     #[serde(default)]
     pub added_mass: Real,
+    /// Fractured points eroded at the step's floor (0 without it, `[time]
+    /// erode_failed_below`).
+    #[serde(default)]
+    pub floor_eroded: u64,
 }
 
 impl Shot {
@@ -810,6 +814,7 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
                 wall: t.elapsed().as_secs_f64(),
                 dir,
                 added_mass: s.mass_scaling.map_or(0.0, |a| a.mass),
+                floor_eroded: s.floor_eroded.unwrap_or(0),
             };
             let kept = FinishedRun { writer: crate::checkpoint::this_writer(), shot: shot.clone() };
             // Not written (a full disk): `--resume` runs it again; the table has it.
@@ -1100,6 +1105,13 @@ pub fn report(header: &str, study: &Study) -> String {
             "Mass scaling (`time.mass_scaling`, not in SPEC §5) added mass at rest to hold the step: at most {:.4e} kg \
              (kg/m in plane strain), in the run at {:.2} m/s; each run's summary gives its own.\n\n",
             most.added_mass, most.speed
+        ));
+    }
+    if let Some(most) = study.shots.iter().filter(|x| x.floor_eroded > 0).max_by_key(|x| x.floor_eroded) {
+        s.push_str(&format!(
+            "Erosion at the step's floor (`time.erode_failed_below`, not in SPEC §5) eroded fractured points to hold \
+             the step: at most {} in one run, at {:.2} m/s; each run's summary gives its own.\n\n",
+            most.floor_eroded, most.speed
         ));
     }
     s.push_str(&format!("{DEFINITIONS}\n\n![v_r against v_i](ballistic.png)\n"));
@@ -1461,6 +1473,7 @@ mod tests {
             steps: 0,
             wall: 0.0,
             added_mass: 0.0,
+            floor_eroded: 0,
             dir: PathBuf::new(),
         }
     }
@@ -1528,6 +1541,33 @@ mod tests {
         assert!(text.contains("no speed held below") && text.contains("not a ballistic limit"), "{text}");
         assert!(!report("header", &scan).contains("not a ballistic limit"));
         assert_eq!(Study { shots: vec![], limit: None, ..study.clone() }.limit_reading(), None);
+    }
+
+    /// The step's floors are named in the report, each with its largest
+    /// run, and only where they acted.
+    #[test]
+    fn the_report_names_the_steps_floors_where_they_acted() {
+        let perf = |v| Verdict::Perforated { residual: v, since: 0.0 };
+        let mut shots = vec![shot(150.0, perf(80.0)), shot(170.0, perf(110.0)), shot(190.0, perf(140.0))];
+        let study = |shots: &[Shot]| Study {
+            shots: shots.to_vec(),
+            failures: vec![],
+            interrupted: false,
+            limit: None,
+            fit: None,
+        };
+        let text = report("header", &study(&shots));
+        assert!(!text.contains("mass_scaling") && !text.contains("erode_failed_below"), "{text}");
+        shots[0].added_mass = 2e-5;
+        shots[1].added_mass = 7e-5;
+        shots[1].floor_eroded = 3;
+        shots[2].floor_eroded = 12;
+        let text = report("header", &study(&shots));
+        assert!(text.contains("at most 7.0000e-5 kg") && text.contains("in the run at 170.00 m/s"), "{text}");
+        assert!(
+            text.contains("`time.erode_failed_below`") && text.contains("at most 12 in one run, at 190.00 m/s"),
+            "{text}"
+        );
     }
 
     #[test]
