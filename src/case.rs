@@ -900,14 +900,14 @@ impl Case {
 
     /// Set on `sim` what a run takes from this case and checkpoints do not
     /// store: heat conduction ([`Case::heat_conduction_for`]), the bulk
-    /// viscosity, mass scaling and erosion at the step's floor. The one
-    /// place for both a fresh run at
-    /// t = 0 and a run resumed from a checkpoint.
+    /// viscosity and the step's floors (mass scaling, erosion). The one
+    /// place for both a fresh run at t = 0 and a run resumed from a
+    /// checkpoint.
     pub fn apply_unstored_settings(&self, sim: &mut crate::step::Simulation) -> Result<(), crate::thermal::HeatError> {
         sim.heat = self.heat_conduction_for(&sim.model)?;
         sim.bulk_viscosity = self.bulk_viscosity();
-        sim.mass_scaling = self.time.mass_scaling;
-        sim.erode_failed_below = self.time.erode_failed_below;
+        sim.floors =
+            crate::stability::Floors { mass_scaling: self.time.mass_scaling, erosion: self.time.erode_failed_below };
         Ok(())
     }
 

@@ -256,20 +256,14 @@ pub struct Simulation {
     pub stable: Option<StableStep>,
     /// The step before this one, s (`dt` at the first step).
     pub dt_previous: Real,
-    /// Mass scaling: the smallest elastic step as a fraction of the rule's
-    /// step `Δt₀`, held by adding mass to the particles that would take it
-    /// lower ([`crate::stability::StableStep::evaluate`]; `[time]
-    /// mass_scaling`); `None`: no mass is added (SPEC §5). Not in
+    /// The step's floors ([`crate::stability::Floors`]): mass scaling, the
+    /// smallest elastic step as a fraction of the rule's step `Δt₀`, held
+    /// by adding mass to the particles that would take it lower (`[time]
+    /// mass_scaling`), and erosion of the fractured points that would
+    /// (`[time] erode_failed_below`); none by default (SPEC §5). Not in
     /// checkpoints: set from the case, as `bulk_viscosity`.
     #[serde(skip)]
-    pub mass_scaling: Option<Real>,
-    /// Erosion at the step's floor: fractured points that would take the
-    /// elastic step below this fraction of `Δt₀` are eroded
-    /// ([`crate::stability::StableStep::evaluate`]; `[time]
-    /// erode_failed_below`); `None`: none is (SPEC §5). Not in
-    /// checkpoints: set from the case, as `mass_scaling`.
-    #[serde(skip)]
-    pub erode_failed_below: Option<Real>,
+    pub floors: Floors,
     /// Per-point internal-energy increments of the last step (scratch; this
     /// and `kinetic_scratch` are not in checkpoints: each step resizes and
     /// rewrites them before reading them).
@@ -315,8 +309,7 @@ impl Simulation {
         Simulation {
             stable,
             dt_previous: dt,
-            mass_scaling: None,
-            erode_failed_below: None,
+            floors: Floors::default(),
             model,
             time: 0.0,
             step: 0,
@@ -445,8 +438,7 @@ impl Simulation {
             return;
         };
         let fracturing = self.cracks.as_ref().is_some_and(|c| c.params.fractures_points());
-        let floors = Floors { mass_scaling: self.mass_scaling, erosion: self.erode_failed_below };
-        let (dt, removed) = stable.evaluate(&mut self.model, self.time, fracturing, self.viscous_damping, floors);
+        let (dt, removed) = stable.evaluate(&mut self.model, self.time, fracturing, self.viscous_damping, self.floors);
         self.energies.mass_scaling += removed;
         self.dt = dt;
     }
@@ -612,20 +604,14 @@ impl Simulation {
                 Some(kin) if J > 0.0 && J.is_finite() => kin,
                 _ if erosion.is_some_and(|p| p.point_failed(c.eps_p[k], c.damage[k])) => {
                     // Inverted after failing: eroded, the run goes on.
-                    c.eroded[k] = true;
-                    c.tau[k] = Block2::zeros();
-                    c.set_pw(k, &Block2::zeros());
-                    c.work[k] = 0.0;
+                    c.erode(k);
                     return None;
                 }
                 _ => return Some((qi, J)),
             };
             if fracturing && crate::material::is_fractured(c.damage[k]) && J >= crate::material::TORN_VOLUME_RATIO {
                 // Torn open (`crate::material::TORN_VOLUME_RATIO`): eroded.
-                c.eroded[k] = true;
-                c.tau[k] = Block2::zeros();
-                c.set_pw(k, &Block2::zeros());
-                c.work[k] = 0.0;
+                c.erode(k);
                 return None;
             }
             let old = crate::material::PointState {
@@ -869,6 +855,15 @@ impl PieceColumns<'_> {
     #[inline]
     fn set_pw(&mut self, k: usize, pw: &Block2) {
         (self.pw[k], self.pw_zz[k]) = (pw.in_plane(), pw.zz);
+    }
+
+    /// Erode entry `k` in the sweep: no stress, no work from now on (the
+    /// sweep's view of [`crate::quadrature::QuadraturePoints::erode`]).
+    fn erode(&mut self, k: usize) {
+        self.eroded[k] = true;
+        self.tau[k] = Block2::zeros();
+        self.set_pw(k, &Block2::zeros());
+        self.work[k] = 0.0;
     }
 }
 

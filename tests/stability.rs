@@ -262,7 +262,7 @@ fn mass_scaling_holds_the_step_at_its_floor_and_keeps_the_margin() {
     let dt0 = 0.5 * model.min_spacing() / model.max_wave_speed();
     let margin0 = exact_highest_frequency(&model) * dt0;
     let mut sim = vibrating(model, TimeStepRule::Cfl { safety: 0.5 });
-    sim.mass_scaling = Some(0.5);
+    sim.floors.mass_scaling = Some(0.5);
     for _ in 0..10 {
         sim.step().unwrap();
     }
