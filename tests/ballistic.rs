@@ -479,21 +479,26 @@ fn a_study_writes_sparse_snapshots_unless_told() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// Mass scaling on a cracking run (`[time] mass_scaling`, here at 0.9 of
-/// the spacing step, above the 0.85 the unscaled run falls to, so that it
-/// acts even on this coarse plate): the step never falls below the floor;
+/// The step's floors on a cracking run. Mass scaling (`[time]
+/// mass_scaling`, here at 0.9 of the spacing step, above the 0.85 the
+/// unscaled run falls to, so that it acts even on this coarse plate): the
+/// step never falls below the floor;
 /// the mass added is a small fraction of the plate's (0.65 %: at so high a
 /// floor the compressed material under the projectile gets some too) and
 /// is reported; the residual velocity stays within 1 % of the unscaled
 /// run's (here equal to the micrometre per second), and the energy
-/// balance closes as well.
+/// balance closes as well. Erosion at the floor (`[time]
+/// erode_failed_below`, at 0.95) erodes fractured points (6 here), which
+/// the summary counts, and keeps the residual within 1 % and the
+/// balance; the step still falls to what the intact crack-face children
+/// allow.
 #[test]
-fn mass_scaling_holds_a_cracking_runs_step_and_keeps_its_residual() {
+fn the_steps_floors_on_a_cracking_run_keep_its_residual() {
     use plugsim::run::{execute, RunConfig, RunInfo};
     let run = |floor: Option<&str>| {
-        let s = setup(&format!("mass-scaling-{}", floor.unwrap_or("off")), 1);
+        let s = setup(&format!("floor-{}", floor.unwrap_or("off").replace([' ', '='], "")), 1);
         let text = match floor {
-            Some(f) => small_plate().replace("stop_after_release", &format!("mass_scaling = {f}\nstop_after_release")),
+            Some(f) => small_plate().replace("stop_after_release", &format!("{f}\nstop_after_release")),
             None => small_plate(),
         };
         let case = Case::from_str_with(&text, "small", &[]).unwrap();
@@ -502,7 +507,8 @@ fn mass_scaling_holds_a_cracking_runs_step_and_keeps_its_residual() {
         std::fs::remove_dir_all(&s.out_dir).ok();
         summary
     };
-    let (off, on) = (run(None), run(Some("0.9")));
+    let (off, on) = (run(None), run(Some("mass_scaling = 0.9")));
+    let eroding = run(Some("erode_failed_below = 0.95"));
     let residual = |s: &plugsim::run::RunSummary| match s.flights[0].1 {
         Verdict::Perforated { residual, .. } => residual,
         v => panic!("{v:?}"),
@@ -530,5 +536,19 @@ fn mass_scaling_holds_a_cracking_runs_step_and_keeps_its_residual() {
         added.mass,
         100.0 * added.mass / plate,
         on.energies.mass_scaling
+    );
+    // Erosion at a floor of 0.95: the fractured points that would take the
+    // step lower go (the summary counts them); the step still falls to
+    // what the intact crack-face children allow, and the residual and the
+    // balance stay.
+    let n = eroding.floor_eroded.expect("the summary counts the floor's points");
+    assert!(n > 0 && n as usize <= eroding.eroded_points, "{n} of {} eroded", eroding.eroded_points);
+    assert!(off.floor_eroded.is_none());
+    let c = residual(&eroding);
+    assert!((a - c).abs() < 0.01 * a, "residual {c} m/s with erosion at the floor against {a} m/s");
+    assert!(eroding.max_drift < off.max_drift + 0.01, "energy drift {} against {}", eroding.max_drift, off.max_drift);
+    eprintln!(
+        "erosion at 0.95 of the spacing step: {n} points, v_r {c:.6} against {a:.6} m/s, {} against {} steps",
+        eroding.steps, off.steps
     );
 }
