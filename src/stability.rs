@@ -318,7 +318,9 @@ impl BoundScratch {
     /// the target are taken stiffest first (ties by index), each with the
     /// points eroded before it left out; each erodes its admitted points,
     /// largest term first (ties by index), until its bound is at most the
-    /// target or none is left. Returns the points in increasing order.
+    /// target, and none where all of them would not bring it there (its
+    /// bound is then set by intact points or its own mass, which erosion
+    /// does not treat). Returns the points in increasing order.
     pub fn erode_failed(&self, model: &Model, target: Real, failed: impl Fn(usize) -> bool) -> Vec<usize> {
         let over = self.stiffest_over(target);
         let (table, gather) = (&model.qp_shape, &model.gather);
@@ -336,6 +338,11 @@ impl BoundScratch {
                 if failed(q) {
                     admitted.push((term, q));
                 }
+            }
+            // Where the failed points cannot bring the bound down (a light
+            // crack-face child sets it), none goes: erosion would not help.
+            if bound - admitted.iter().map(|&(term, _)| term).sum::<Real>() > target {
+                continue;
             }
             admitted.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
             for (term, q) in admitted {
