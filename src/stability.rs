@@ -93,7 +93,8 @@
 //!   points (`D ≥ 1` while cracks grow, pressure only,
 //!   [`crate::material::fractured`]) that take a particle's bound above
 //!   the floor's target `(ω_ref / f)²`, as few as bring it there, largest
-//!   term first ([`BoundScratch::erode_failed`]); an eroded point carries
+//!   term first, and none where all of them would not
+//!   ([`BoundScratch::erode_failed`]); an eroded point carries
 //!   no stress from then on ([`crate::quadrature::QuadraturePoints::erode`]),
 //!   its particles keep their mass. Intact or merely damaged points are
 //!   never eroded: where they set the step it falls as before. What it
