@@ -468,9 +468,9 @@ impl StableStep {
     /// on a full lattice (0 without it; the step is then the elastic one bit
     /// for bit), and the particle that sets it.
     ///
-    /// With `mass_floor` (mass scaling, `[time] mass_scaling`), mass is
+    /// With `floors.mass_scaling` (`[time] mass_scaling`), mass is
     /// first added to every particle whose bound would take the elastic
-    /// step below `mass_floor · Δt₀` ([`BoundScratch::scale_masses`]),
+    /// step below `floors.mass_scaling · Δt₀` ([`BoundScratch::scale_masses`]),
     /// at rest: its velocity drops so that its momentum stays, and the
     /// kinetic energy this takes out is returned (J; 0 without mass
     /// added), for the energy account.
@@ -501,9 +501,8 @@ impl StableStep {
                 self.scratch.fill(model, true, fracturing);
             }
         }
-        let mass_floor = floors.mass_scaling;
         let mut removed = 0.0;
-        if let Some(floor) = mass_floor {
+        if let Some(floor) = floors.mass_scaling {
             let target = (self.reference / floor).powi(2);
             let scaled = self.scratch.scale_masses(model, target);
             if !scaled.is_empty() {
