@@ -287,6 +287,53 @@ pub fn target(case: &Case) -> Option<usize> {
     (0..case.bodies.len()).find(|b| !flying.contains(b))
 }
 
+/// Where the projectile's edge lies against the target's particle columns
+/// ([`edge_phase`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EdgePhase {
+    /// The projectile's edge: the largest x of its outline (in axisymmetry
+    /// its radius), m.
+    pub edge: Real,
+    /// The target's particle column nearest to it, m.
+    pub column: Real,
+    /// `(edge − column) / h` in [−½, ½], `h` the gap to the next column on
+    /// the edge's side ([`crate::discretize::RectangleGrid::column_offset`]).
+    pub offset: Real,
+}
+
+/// The projectile's edge against the particle columns of `case`'s target
+/// ([`target`]): the lattice's phase at the rim of a flat-nosed
+/// projectile, which picks the rim crack's first steps and, near a fork,
+/// the failure mode (docs/validation.md, "A particle column on the
+/// projectile's edge"; Case II's plate at 72 rows, where it is −0.39).
+/// Every study and every rung of a ladder reports it. `None` when the
+/// edge lies outside the target.
+pub fn edge_phase(case: &Case, projectile: Projectile) -> Option<EdgePhase> {
+    let case = case.resolved();
+    let grid = &case.bodies.get(target(&case)?)?.rectangle;
+    let edge = match projectile {
+        Projectile::Rigid(k) => {
+            case.rigid_body(case.rigid_bodies.get(k)?).ok()?.outline_global().map(|p| p.x).reduce(Real::max)?
+        }
+        Projectile::Deformable(b) => case.bodies.get(b)?.rectangle.x_max,
+    };
+    let (column, offset) = grid.column_offset(edge)?;
+    Some(EdgePhase { edge, column, offset })
+}
+
+impl EdgePhase {
+    /// For a report: "the projectile's edge (x = 10.000 mm) lies −0.39 of
+    /// a spacing from the nearest particle column (x = 10.056 mm)".
+    pub fn describe(&self) -> String {
+        format!(
+            "the projectile's edge (x = {:.3} mm) lies {:+.2} of a spacing from the target's nearest particle column (x = {:.3} mm)",
+            self.edge * 1e3,
+            self.offset,
+            self.column * 1e3
+        )
+    }
+}
+
 /// The deformable projectiles of `case` by index among its bodies.
 fn flying_bodies(case: &Case) -> Vec<usize> {
     case.deformable_flights().into_iter().map(|(_, b, _)| b).collect()
@@ -1168,13 +1215,16 @@ pub struct Rung {
     pub spacing: Real,
     /// The `--set` overrides that give this resolution.
     pub overrides: Vec<String>,
+    /// The projectile's edge against this resolution's columns
+    /// ([`edge_phase`]).
+    pub edge: Option<EdgePhase>,
     pub study: Study,
 }
 
 /// The resolutions side by side, as (Markdown, CSV): per rung the ballistic
-/// limit, the Recht–Ipson fit and the residual velocity at each of
-/// `speeds`, then the spread of each across the rungs ([`spread`]), the
-/// last refinement's [`step`] (from the second-finest rung to the finest:
+/// limit, the Recht–Ipson fit, the residual velocity at each of `speeds`
+/// and the projectile's edge against its columns ([`edge_phase`]), then
+/// the spread of each across the rungs ([`spread`]), the last refinement's [`step`] (from the second-finest rung to the finest:
 /// what one more refinement moved, the usual test of a converged result)
 /// and, with three rungs or more, what the three finest say of the answer
 /// at zero spacing ([`richardson`]: the observed order, the extrapolated
@@ -1190,10 +1240,10 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
         md.push_str(&format!(" v_r at {v:.1} m/s |"));
         csv.push_str(&format!(",v_r_at_{v:.1}"));
     }
-    md.push_str(" runs | wall (s) |\n|---|---|---|---|");
-    md.push_str(&"---|".repeat(speeds.len() + 2));
+    md.push_str(" runs | wall (s) | edge − column (spacings) |\n|---|---|---|---|");
+    md.push_str(&"---|".repeat(speeds.len() + 3));
     md.push('\n');
-    csv.push_str(",runs,wall_s\n");
+    csv.push_str(",runs,wall_s,edge_offset\n");
     // Each rung's limit (value, half-width) if bracketed, its residual at a
     // speed, and that residual where it perforated (the spread and the step
     // compare those only).
@@ -1237,8 +1287,13 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
             });
             csv.push_str(&format!(",{}", vr.map_or(String::new(), |x| format!("{x:.3}"))));
         }
-        md.push_str(&format!(" {} | {wall:.0} |\n", st.shots.len()));
-        csv.push_str(&format!(",{},{wall:.2}\n", st.shots.len()));
+        let edge = r.edge.map(|e| e.offset);
+        md.push_str(&format!(
+            " {} | {wall:.0} | {} |\n",
+            st.shots.len(),
+            edge.map_or("—".into(), |o| format!("{o:+.2}"))
+        ));
+        csv.push_str(&format!(",{},{wall:.2},{}\n", st.shots.len(), edge.map_or(String::new(), |o| format!("{o:.4}"))));
     }
     let pct = |s: Option<Real>| s.map_or("—".into(), |x| format!("{:.1} %", 100.0 * x));
     let limits: Vec<Real> = rungs.iter().filter_map(|r| limit_of(&r.study).map(|e| e.0)).collect();
@@ -1250,7 +1305,7 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
         let vr: Option<Vec<Real>> = rungs.iter().map(|r| perforated_at(&r.study, v)).collect();
         md.push_str(&format!(" {} |", pct(vr.and_then(|x| spread(&x)))));
     }
-    md.push_str(" | |\n");
+    md.push_str(" | | |\n");
     // The two finest rungs, by rows (the order given need not be).
     let mut by_rows: Vec<&Rung> = rungs.iter().collect();
     by_rows.sort_by_key(|r| r.rows);
@@ -1271,7 +1326,7 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
                 _ => " — |".into(),
             });
         }
-        md.push_str(" | |\n");
+        md.push_str(" | | |\n");
     }
     if let [.., third, second, first] = by_rows[..] {
         let three = [third, second, first];
@@ -1290,7 +1345,7 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
             let rungs = ladder(&|r| perforated_at(&r.study, v).map(|x| (x, 0.0)));
             md.push_str(&format!(" {} |", convergence::describe(rungs.and_then(|l| richardson(&l)))));
         }
-        md.push_str(" | |\n");
+        md.push_str(" | | |\n");
     }
     (md, csv)
 }
@@ -1638,6 +1693,39 @@ mod tests {
         assert!(at_rows(&two, 1).unwrap_err().to_string().contains("at least 2"));
     }
 
+    /// The lattice's phase at the rim, by hand: the built-in plates' fine
+    /// zones start on the axis at the thickness spacing `h = T / (rows −
+    /// 1)`, so the projectile's 10 mm radius lies `10/h − round(10/h)`
+    /// spacings from the nearest column: Case II's plate at 72 rows −0.39
+    /// (the rung whose rim crack takes another path, docs/validation.md),
+    /// the 12 mm plate +0.17 at every rung. A column put on the edge
+    /// (`column_at`) reads 0.
+    #[test]
+    fn the_projectile_s_edge_against_the_columns_by_hand() {
+        for (name, thickness) in [("borvik-2-axisymmetric-nonlocal", 10.2e-3), ("borvik-2002-12mm-blunt", 12e-3)] {
+            let case = builtin(name, &[]);
+            let projectile = select_projectile(&case, name, None).unwrap();
+            for rows in [24, 48, 72, 96] {
+                let (refined, _) = at_rows(&case, rows).unwrap();
+                let e = edge_phase(&refined, projectile).unwrap();
+                let n = 0.01 / (thickness / (rows - 1) as Real);
+                assert!((e.edge - 0.01).abs() < 1e-12, "{name}: edge {}", e.edge);
+                assert!(
+                    (e.offset - (n - n.round())).abs() < 1e-6,
+                    "{name} {rows}: {} against {}",
+                    e.offset,
+                    n - n.round()
+                );
+            }
+        }
+        let case = builtin("borvik-2-axisymmetric-nonlocal", &[]);
+        let (mut refined, _) = at_rows(&case, 72).unwrap();
+        assert!((edge_phase(&refined, Projectile::Rigid(0)).unwrap().offset + 0.392).abs() < 1e-3);
+        refined.bodies[0].rectangle.column_at = Some(0.01);
+        assert!(edge_phase(&refined, Projectile::Rigid(0)).unwrap().offset.abs() < 1e-9);
+        assert!(edge_phase(&refined, Projectile::Rigid(0)).unwrap().describe().contains("+0.00 of a spacing"));
+    }
+
     #[test]
     fn the_ladder_table_gives_the_spread_of_limits_and_residuals() {
         let perf = |v| Verdict::Perforated { residual: v, since: 0.0 };
@@ -1646,14 +1734,25 @@ mod tests {
             rows,
             spacing: 0.012 / rows as Real,
             overrides: Vec::new(),
+            edge: None,
             study: Study {
                 shots: vec![shot(200.0, at_200), shot(300.0, perf(at_300))],
                 limit: Some(Limit { held: Some(lo), perforated: Some(hi), tol: 1.0, non_monotonic: None }),
                 ..Study::default()
             },
         };
-        let rungs = [rung(12, (119.0, 121.0), perf(100.0), 250.0), rung(24, (129.0, 131.0), perf(110.0), 250.0)];
+        let mut rungs = [rung(12, (119.0, 121.0), perf(100.0), 250.0), rung(24, (129.0, 131.0), perf(110.0), 250.0)];
+        rungs[0].edge = Some(EdgePhase { edge: 0.01, column: 0.00982, offset: 0.18 });
         let (md, csv) = ladder_table(&rungs, &[200.0, 300.0]);
+        // the edge's phase: given on the first rung, unknown on the second
+        assert!(
+            md.lines().nth(2).unwrap().ends_with("| +0.18 |") && md.lines().nth(3).unwrap().ends_with("| — |"),
+            "{md}"
+        );
+        assert!(
+            csv.lines().nth(1).unwrap().ends_with(",0.1800") && csv.lines().nth(2).unwrap().ends_with(','),
+            "{csv}"
+        );
         // limits 120 and 130: 10/125 = 8.0 %; at 200 m/s 100 and 110: 10/105 = 9.5 %; at 300 m/s 0 %
         let spread_row = md.lines().find(|l| l.starts_with("| spread")).unwrap();
         assert!(

@@ -189,6 +189,25 @@ impl RectangleGrid {
         xs
     }
 
+    /// Where `x` lies against the particle columns ([`Self::columns`]; a
+    /// resolved grid): the nearest column and the offset `(x − column) / h`
+    /// in [−½, ½], `h` the gap from that column to its neighbour on `x`'s
+    /// side. `None` outside `[x_min, x_max]`. Under a flat-nosed projectile
+    /// the offset of its edge is the lattice's phase at the rim, which
+    /// changes from one resolution to the next unless `column_at` holds it
+    /// at 0 (`docs/validation.md`, "A particle column on the projectile's
+    /// edge").
+    pub fn column_offset(&self, x: Real) -> Option<(Real, Real)> {
+        if !(self.x_min..=self.x_max).contains(&x) {
+            return None;
+        }
+        let xs = self.columns();
+        let k = (0..xs.len()).min_by(|&a, &b| (xs[a] - x).abs().total_cmp(&(xs[b] - x).abs()))?;
+        let neighbour = if x >= xs[k] { xs.get(k + 1) } else { k.checked_sub(1).map(|j| &xs[j]) };
+        let h = neighbour.map_or(Real::INFINITY, |n| (n - xs[k]).abs());
+        Some((xs[k], if h > 0.0 { (x - xs[k]) / h } else { 0.0 }))
+    }
+
     /// Generate particles and Gauss points.
     pub fn generate(&self, mode: GeometryMode) -> GeneratedBody {
         let xs = self.columns();
@@ -378,6 +397,37 @@ mod tests {
                 assert_eq!(again, g.fine_spacing, "resolving twice");
             }
         }
+    }
+
+    /// The edge's phase against the columns, by hand: in axisymmetry the
+    /// fine zone's columns lie at `k h` from the axis, so a radius of 10 mm
+    /// lies `10/h − round(10/h)` spacings from the nearest; with
+    /// `column_at` on it, 0. Outside the body, none.
+    #[test]
+    fn the_offset_of_an_edge_from_the_nearest_column_by_hand() {
+        for layers in [12, 24, 48, 72, 96] {
+            let mut g = RectangleGrid { x_min: 0.0, ..plate(layers, 0.02, 1.03, 0.004) };
+            g.resolve(GeometryMode::Axisymmetric);
+            let h = 0.0111 / (layers - 1) as Real;
+            let n = 0.01 / h;
+            let (column, offset) = g.column_offset(0.01).unwrap();
+            assert!((offset - (n - n.round())).abs() < 1e-9, "{layers}: {offset} against {}", n - n.round());
+            assert!((column - n.round() * h).abs() < 1e-12 && offset.abs() <= 0.5);
+            let mut on = RectangleGrid { column_at: Some(0.01), ..g.clone() };
+            on.resolve(GeometryMode::Axisymmetric);
+            assert!(on.column_offset(0.01).unwrap().1.abs() < 1e-9, "{layers}: column_at");
+            assert_eq!(g.column_offset(0.1 + 1e-6), None);
+            assert_eq!(g.column_offset(-1e-6), None);
+        }
+        // graded: the gap on the edge's side, not the fine spacing
+        let mut g = RectangleGrid { x_min: 0.0, ..plate(24, 0.005, 1.2, 0.004) };
+        g.resolve(GeometryMode::Axisymmetric);
+        let xs = g.columns();
+        let k = xs.iter().position(|&c| c > 0.03).unwrap();
+        let x = xs[k] + 0.25 * (xs[k + 1] - xs[k]);
+        let (column, offset) = g.column_offset(x).unwrap();
+        assert_eq!(column, xs[k]);
+        assert!((offset - 0.25).abs() < 1e-12, "{offset}");
     }
 
     #[test]

@@ -633,9 +633,10 @@ fn ballistic(
             if extra.is_empty() { String::new() } else { format!(": {}", extra.join(" ")) }
         );
         let all: Vec<String> = set.iter().chain(&extra).cloned().collect();
+        let edge = plugsim::ballistic::edge_phase(&refined, projectile);
         let study = one_study(refined, file, &all, projectile, &dir, &args, &experiments, &interrupt, started)?;
         let stop = study.interrupted;
-        rungs.push(Rung { rows, spacing, overrides: extra, study });
+        rungs.push(Rung { rows, spacing, overrides: extra, edge, study });
         if stop {
             break;
         }
@@ -713,8 +714,10 @@ fn one_study(
         plugsim::ballistic::Projectile::Deformable(_) => ", deformable: v_r its mass-averaged velocity",
     };
     let snapshots = setup.case.resolved().output.interval.unwrap_or(0.0);
+    let edge = plugsim::ballistic::edge_phase(&setup.case, projectile)
+        .map_or(String::new(), |e| format!("; {}", e.describe()));
     let header = format!(
-        "Case {file}{}; projectile `{body}` (case impact speed {impact:.1} m/s{kind}); {jobs} runs side by side, {threads_per_run} thread(s) each, \
+        "Case {file}{}; projectile `{body}` (case impact speed {impact:.1} m/s{kind}){edge}; {jobs} runs side by side, {threads_per_run} thread(s) each, \
          a snapshot every {:.3} us; produced by `plugsim ballistic` ({} {}) on {}.",
         if set.is_empty() { String::new() } else { format!(" with {}", set.join(" ")) },
         snapshots * 1e6,
