@@ -1398,8 +1398,10 @@ pub fn write_ladder_files(
          convergence p, the value extrapolated to zero spacing and the grid convergence index of the finest \
          (1.25 |finest − next| / (r^p − 1) relative to the finest, r the spacing ratio; Celik et al. 2008), given \
          only when the two steps have one sign and the last is the smaller (else it says why not); a limit's \
-         step within its brackets gives none. Each resolution's own table, report and plot are in \
-         `rows-N/` (its `--set` overrides in its header).\n\n",
+         step within its brackets gives none. Edge − column: where the projectile's edge lies against the \
+         target's nearest particle column at that resolution, in spacings (the lattice's phase at the rim; near a \
+         limit the rim crack's first steps can depend on it, and a grid's `column_at` holds it at 0). Each \
+         resolution's own table, report and plot are in `rows-N/` (its `--set` overrides in its header).\n\n",
     );
     for r in rungs {
         let set = if r.overrides.is_empty() { "the case as given".to_string() } else { r.overrides.join(" ") };
