@@ -303,9 +303,10 @@ pub struct EdgePhase {
 
 /// The projectile's edge against the particle columns of `case`'s target
 /// ([`target`]): the lattice's phase at the rim of a flat-nosed
-/// projectile, which picks the rim crack's first steps and, near a fork,
-/// the failure mode (docs/validation.md, "A particle column on the
-/// projectile's edge"; Case II's plate at 72 rows, where it is −0.39).
+/// projectile, which can pick the rim crack's first steps and, near a
+/// fork, the failure mode (docs/validation.md, "A particle column on the
+/// projectile's edge" and "Case II's plate on the 48 / 72 / 96 ladder";
+/// Case II's plate at 72 rows, where it is −0.39).
 /// Every study and every rung of a ladder reports it. `None` when the
 /// edge lies outside the target.
 pub fn edge_phase(case: &Case, projectile: Projectile) -> Option<EdgePhase> {
@@ -323,7 +324,8 @@ pub fn edge_phase(case: &Case, projectile: Projectile) -> Option<EdgePhase> {
 
 impl EdgePhase {
     /// For a report: "the projectile's edge (x = 10.000 mm) lies −0.39 of
-    /// a spacing from the nearest particle column (x = 10.056 mm)".
+    /// a spacing from the target's nearest particle column (x = 10.056
+    /// mm)".
     pub fn describe(&self) -> String {
         format!(
             "the projectile's edge (x = {:.3} mm) lies {:+.2} of a spacing from the target's nearest particle column (x = {:.3} mm)",
@@ -1224,7 +1226,8 @@ pub struct Rung {
 /// The resolutions side by side, as (Markdown, CSV): per rung the ballistic
 /// limit, the Recht–Ipson fit, the residual velocity at each of `speeds`
 /// and the projectile's edge against its columns ([`edge_phase`]), then
-/// the spread of each across the rungs ([`spread`]), the last refinement's [`step`] (from the second-finest rung to the finest:
+/// the spread of each across the rungs ([`spread`]), the last
+/// refinement's [`step`] (from the second-finest rung to the finest:
 /// what one more refinement moved, the usual test of a converged result)
 /// and, with three rungs or more, what the three finest say of the answer
 /// at zero spacing ([`richardson`]: the observed order, the extrapolated
