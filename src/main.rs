@@ -619,7 +619,7 @@ fn ballistic(
     let interrupt = install_interrupt_handler();
     let started = Instant::now();
     if resolutions.is_empty() {
-        let study = one_study(case, file, set, projectile, &out_dir, &args, &experiments, &interrupt, started)?;
+        let (study, _) = one_study(case, file, set, projectile, &out_dir, &args, &experiments, &interrupt, started)?;
         return finish(&study);
     }
     let mut rungs = Vec::new();
@@ -633,8 +633,7 @@ fn ballistic(
             if extra.is_empty() { String::new() } else { format!(": {}", extra.join(" ")) }
         );
         let all: Vec<String> = set.iter().chain(&extra).cloned().collect();
-        let edge = plugsim::ballistic::edge_phase(&refined, projectile);
-        let study = one_study(refined, file, &all, projectile, &dir, &args, &experiments, &interrupt, started)?;
+        let (study, edge) = one_study(refined, file, &all, projectile, &dir, &args, &experiments, &interrupt, started)?;
         let stop = study.interrupted;
         rungs.push(Rung { rows, spacing, overrides: extra, edge, study });
         if stop {
@@ -675,7 +674,9 @@ fn finish(study: &plugsim::ballistic::Study) -> Result<()> {
 }
 
 /// One ballistic study of `case` (the speeds, then the limit if asked) into
-/// `out_dir`: its table, report and plot, printed and written.
+/// `out_dir`: its table, report and plot, printed and written; with the
+/// projectile's edge against the target's columns that its header states
+/// (a ladder's rung reports the same).
 #[allow(clippy::too_many_arguments)]
 fn one_study(
     case: Case,
@@ -687,7 +688,7 @@ fn one_study(
     experiments: &[(f64, f64)],
     interrupt: &Option<Arc<AtomicBool>>,
     started: Instant,
-) -> Result<plugsim::ballistic::Study> {
+) -> Result<(plugsim::ballistic::Study, Option<plugsim::ballistic::EdgePhase>)> {
     use plugsim::ballistic::{find_limit, flight, run_speeds, write_files};
     use plugsim::ballistic::{Event, Setup, Study};
     let (_, impact) = flight(&case, projectile);
@@ -714,8 +715,8 @@ fn one_study(
         plugsim::ballistic::Projectile::Deformable(_) => ", deformable: v_r its mass-averaged velocity",
     };
     let snapshots = setup.case.resolved().output.interval.unwrap_or(0.0);
-    let edge = plugsim::ballistic::edge_phase(&setup.case, projectile)
-        .map_or(String::new(), |e| format!("; {}", e.describe()));
+    let edge_phase = plugsim::ballistic::edge_phase(&setup.case, projectile);
+    let edge = edge_phase.map_or(String::new(), |e| format!("; {}", e.describe()));
     let header = format!(
         "Case {file}{}; projectile `{body}` (case impact speed {impact:.1} m/s{kind}){edge}; {jobs} runs side by side, {threads_per_run} thread(s) each, \
          a snapshot every {:.3} us; produced by `plugsim ballistic` ({} {}) on {}.",
@@ -781,7 +782,7 @@ fn one_study(
     for f in files {
         println!("written: {}", f.display());
     }
-    Ok(study)
+    Ok((study, edge_phase))
 }
 
 /// The CPU's model name from `/proc/cpuinfo`, for the provenance lines of
