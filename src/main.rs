@@ -266,6 +266,9 @@ fn dispatch(cmd: Command) -> Result<()> {
                 info: RunInfo::current(&file, &set),
                 interrupt: install_interrupt_handler(),
             };
+            if let Some(rim) = rim_phase(&case) {
+                eprintln!("plugsim: {rim}");
+            }
             drive(&cfg, |cfg, report| execute(&case, cfg, report))
         }
         Command::Resume { dir } => {
@@ -880,6 +883,17 @@ fn bench(name: &str, steps: usize, whole: Option<f64>, set: &[String]) -> Result
     Ok(())
 }
 
+/// Where the projectile's edge lies against the target's particle
+/// columns ([`plugsim::ballistic::edge_phase`]), for a case with one
+/// projectile whose edge lies over its target: what `plugsim ballistic`
+/// states in every study's header, said by `check` and `run` too, since the
+/// lattice's phase at the rim can pick a crack's first steps
+/// (docs/validation.md, "Case II's plate on the 48 / 72 / 96 ladder").
+fn rim_phase(case: &Case) -> Option<String> {
+    let projectile = plugsim::ballistic::select_projectile(case, "", None).ok()?;
+    plugsim::ballistic::edge_phase(case, projectile).map(|e| e.describe())
+}
+
 fn check(case: &Case, file: &str) -> Result<()> {
     let resolved = case.resolved();
     let t = Instant::now();
@@ -905,6 +919,9 @@ fn check(case: &Case, file: &str) -> Result<()> {
             );
         }
         println!("  contact slaves  {} surface particles", c.slaves.len());
+    }
+    if let Some(rim) = rim_phase(case) {
+        println!("  rim             {rim}");
     }
     println!(
         "  time step       {:.3e} s ({} steps to {:.3e} s)",
