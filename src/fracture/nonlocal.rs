@@ -38,13 +38,18 @@
 //!
 //! **Why the average weights areas, not volumes, in axisymmetry** (and how
 //! it carries to 3D): in 3D the average is over a ball of radius `ℓ`. A
-//! field that does not vary along the hoop direction, averaged in 3D with
-//! the separable Gaussian-like weight about a point at radius `R ≫ ℓ`, is
-//! the 2D average in the r-z section with the same weight and plane areas
-//! (the hoop integral is the same for every point of the section). The
-//! weight table is then a 3D neighbour list over Gauss points within `ℓ`,
-//! cut by crack surfaces instead of segments (a sight line crossing a
-//! crack triangle); `ℓ` and the locus are unchanged.
+//! field that does not vary along the hoop direction, averaged in 3D
+//! about a point at radius `R ≫ ℓ`, is a 2D average in the r-z section
+//! with plane areas (the hoop integral is the same for every point of the
+//! section), whose weight is the 3D one integrated along the hoop: a
+//! Gaussian stays itself, but the bell `(1 − r²/ℓ²)²` becomes
+//! `∝ (1 − ρ²/ℓ²)^{5/2}`, whose band width is the ball's `32ℓ/35`, not
+//! the section bell's `5πℓ/16` ([`band_averaging_width`]). So a 3D model
+//! with the same `ℓ` and `w` asks a 7.4 % higher average (0.219 against
+//! 0.204); `docs/design-3d.md` §6.3 says how to keep the two the same.
+//! The weight table is then a 3D neighbour list over Gauss points within
+//! `ℓ`, cut by crack surfaces instead of segments (a sight line crossing
+//! a crack triangle); the locus is unchanged.
 //!
 //! **`ℓ` and `w`.** `ℓ` (default 1.0 mm) is an averaging length, not
 //! the band's: it must cover the band the coarsest lattice forms (about
