@@ -145,8 +145,10 @@ pub const MAGIC: [u8; 8] = *b"PLUGCKPT";
 /// version 12 the quadrature points' triaxiality integrated over the
 /// plastic strain ([`crate::quadrature::QuadraturePoints::triaxiality_strain`]),
 /// version 13 the count of points eroded at the step's floor
-/// ([`crate::stability::StableStep::eroded`]).
-pub const FORMAT_VERSION: u32 = 13;
+/// ([`crate::stability::StableStep::eroded`]), version 14 the fastest
+/// particle's reference position, mass and crack-face flag
+/// ([`crate::step::FastestParticle`]).
+pub const FORMAT_VERSION: u32 = 14;
 /// Subdirectory of a run's output directory that holds its checkpoints.
 pub const DIRECTORY: &str = "checkpoints";
 /// File name extension of a checkpoint.

@@ -1064,15 +1064,7 @@ fn drive(
     if s.max_drift > 0.05 {
         println!("  WARNING: the energy balance drifted by more than 5 % of the input energy");
     }
-    let f = &s.fastest;
-    println!(
-        "  fastest particle: {:.1} m/s, particle {} at ({:.2}, {:.2}) mm, t = {:.3} us (history.csv: max_particle_speed)",
-        f.speed,
-        f.particle,
-        f.position.x * 1e3,
-        f.position.y * 1e3,
-        f.time * 1e6
-    );
+    println!("  fastest particle: {} (history.csv: max_particle_speed)", s.fastest.describe());
     println!(
         "  wall time {:.2} s: setup {:.2} s, time loop {:.2} s, output {:.2} s",
         total.as_secs_f64(),

@@ -182,6 +182,34 @@ pub struct FastestParticle {
     pub time: Real,
     /// Its physical position `X_I + Σ_J N_J(X_I) U_J` then, m.
     pub position: Vec2,
+    /// Its reference position `X_I`, m: where the material came from.
+    pub reference: Vec2,
+    /// Its lumped mass then, kg (kg/m in plane strain).
+    pub mass: Real,
+    /// Whether it lay on a crack face then (a split's child or parent):
+    /// the light particles a split makes are the usual fast ones
+    /// (docs/validation.md, "Fastest particle").
+    pub crack_face: bool,
+}
+
+impl FastestParticle {
+    /// For a run summary: "534.0 m/s, particle 114144 (a crack-face
+    /// particle of 1.690e-6 kg from (9.877, 10.200) mm) at (12.43, 14.73)
+    /// mm, t = 14.880 us".
+    pub fn describe(&self) -> String {
+        format!(
+            "{:.1} m/s, particle {} ({} of {:.3e} kg from ({:.3}, {:.3}) mm) at ({:.2}, {:.2}) mm, t = {:.3} us",
+            self.speed,
+            self.particle,
+            if self.crack_face { "a crack-face particle" } else { "a particle" },
+            self.mass,
+            self.reference.x * 1e3,
+            self.reference.y * 1e3,
+            self.position.x * 1e3,
+            self.position.y * 1e3,
+            self.time * 1e6
+        )
+    }
 }
 
 /// `(sqrt(max_I s2(I)), I)` over `n` particles, for a squared speed `s2`:
@@ -913,8 +941,17 @@ impl Simulation {
         let (speed, i) = fastest_particle(&self.model);
         if speed > self.fastest.speed {
             let m = &self.model;
-            let position = m.particles.x0[i] + m.particle_shape.interpolate(i, &m.particles.u);
-            self.fastest = FastestParticle { speed, particle: i, time: self.time, position };
+            let p = &m.particles;
+            let position = p.x0[i] + m.particle_shape.interpolate(i, &p.u);
+            self.fastest = FastestParticle {
+                speed,
+                particle: i,
+                time: self.time,
+                position,
+                reference: p.x0[i],
+                mass: p.mass[i],
+                crack_face: p.flags[i].has(crate::particles::ParticleFlags::CRACK_FACE),
+            };
         }
     }
 

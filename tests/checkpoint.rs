@@ -399,19 +399,20 @@ fn checkpoint_of_another_format_version_is_refused_naming_both() {
     }
 }
 
-/// Format 12 (postcard, before the count of points eroded at the step's
-/// floor) is refused, naming both versions, rather than misread.
+/// Format 13 (postcard, before the fastest particle's reference position,
+/// mass and crack-face flag) is refused, naming both versions, rather than
+/// misread.
 #[test]
 fn older_format_version_checkpoint_is_refused_naming_both_versions() {
-    assert_eq!(FORMAT_VERSION, 13);
+    assert_eq!(FORMAT_VERSION, 14);
     let case = case(STRIKE, &["time.end=1e-6"]);
-    let dir = scratch("version-12");
+    let dir = scratch("version-13");
     let path = run_until(&case, &dir, 2);
-    corrupt(&path, 8, &12u32.to_le_bytes());
+    corrupt(&path, 8, &13u32.to_le_bytes());
     let e = checkpoint::read(&path).unwrap_err().to_string();
-    assert!(e.contains("format version 12 ") && e.contains("reads format version 13"), "{e}");
+    assert!(e.contains("format version 13 ") && e.contains("reads format version 14"), "{e}");
     let e = resume(&config(&dir, None), &mut |_| {}).unwrap_err().to_string();
-    assert!(e.contains("format version 12 ") && e.contains("format version 13"), "{e}");
+    assert!(e.contains("format version 13 ") && e.contains("format version 14"), "{e}");
 }
 
 #[test]

@@ -3,6 +3,7 @@
 
 use plugsim::case::Case;
 use plugsim::cases::builtin_case;
+use plugsim::particles::ParticleFlags;
 use plugsim::run::build_simulation;
 use plugsim::step::fastest_particle;
 
@@ -33,8 +34,16 @@ fn no_particle_leaves_faster_than_the_rear_face_doubling() {
     let v_i = 298.0;
     let mut sim = build_simulation(&case).unwrap();
     let (mut up, mut fastest) = (0.0_f64, 0.0_f64);
+    let mut children = 0;
     while sim.time < 6e-6 {
         sim.step().unwrap();
+        if sim.fastest.time == sim.time {
+            // A new record names the particle as it is now.
+            let (f, p) = (&sim.fastest, &sim.model.particles);
+            assert_eq!((f.reference, f.mass), (p.x0[f.particle], p.mass[f.particle]));
+            assert_eq!(f.crack_face, p.flags[f.particle].has(ParticleFlags::CRACK_FACE));
+            children += usize::from(f.crack_face);
+        }
         let v = sim.model.physical(&sim.model.particles.v);
         up = v.iter().map(|v| v.y).fold(up, f64::max);
         fastest = v.iter().map(|v| v.norm()).fold(fastest, f64::max);
@@ -46,6 +55,9 @@ fn no_particle_leaves_faster_than_the_rear_face_doubling() {
     assert_eq!(sim.fastest.speed, fastest, "the run's record is the largest physical speed of any step");
     let i = sim.fastest.particle;
     assert!(i < sim.model.particles.len() && sim.fastest.time > 0.0 && sim.fastest.time <= sim.time);
+    let line = sim.fastest.describe();
+    assert!(line.starts_with(&format!("{:.1} m/s, particle {i} (a ", sim.fastest.speed)), "{line}");
+    eprintln!("fastest: {line}; records held by crack-face particles: {children}");
 }
 
 /// Issue #19 item 5: a crack split rebuilds the shape-function rows around
