@@ -147,7 +147,8 @@ pub const MAGIC: [u8; 8] = *b"PLUGCKPT";
 /// version 13 the count of points eroded at the step's floor
 /// ([`crate::stability::StableStep::eroded`]), version 14 the fastest
 /// particle's reference position, mass and crack-face flag
-/// ([`crate::step::FastestParticle`]).
+/// ([`crate::step::FastestParticle`]) and the non-local average's weight
+/// ([`crate::fracture::FractureParameters::nonlocal_weight`]).
 pub const FORMAT_VERSION: u32 = 14;
 /// Subdirectory of a run's output directory that holds its checkpoints.
 pub const DIRECTORY: &str = "checkpoints";

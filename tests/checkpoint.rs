@@ -400,8 +400,8 @@ fn checkpoint_of_another_format_version_is_refused_naming_both() {
 }
 
 /// Format 13 (postcard, before the fastest particle's reference position,
-/// mass and crack-face flag) is refused, naming both versions, rather than
-/// misread.
+/// mass and crack-face flag and the non-local average's weight) is
+/// refused, naming both versions, rather than misread.
 #[test]
 fn older_format_version_checkpoint_is_refused_naming_both_versions() {
     assert_eq!(FORMAT_VERSION, 14);

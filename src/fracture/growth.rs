@@ -494,7 +494,9 @@ impl CrackGrowth {
     /// The quadrature points binned for the averages over `ℓ` (built on
     /// first use: the points do not move in the reference configuration).
     fn nonlocal_average(&self, model: &Model) -> &NonlocalAverage {
-        self.nonlocal.get_or_init(|| NonlocalAverage::new(&model.quad.x0, self.params.nonlocal_radius))
+        self.nonlocal.get_or_init(|| {
+            NonlocalAverage::new(&model.quad.x0, self.params.nonlocal_radius, self.params.nonlocal_weight)
+        })
     }
 
     /// Whether particle `i`'s criterion value may reach `critical`: false
