@@ -321,7 +321,10 @@
 //!   In 3D the same ingredients carry over: `ℓ` is a ball over the Gauss
 //!   points cut by crack triangles, `w/L` with the 3D bell's band width
 //!   (`∫α dV/∫α dA` over a plane: `32ℓ/35`, against `5πℓ/16` here, so
-//!   the same `ℓ` asks a 7.4 % higher average; `docs/design-3d.md` §6.3), the locus unchanged, the allowance per
+//!   the same `ℓ` asks a 7.4 % higher average; `docs/design-3d.md` §6.3;
+//!   `nonlocal_weight = "ball"`, an option, averages a 2D run with the 3D
+//!   weight: [`NonlocalWeight`], measured in `docs/validation.md`, "The
+//!   average's weight as a 3D ball's"), the locus unchanged, the allowance per
 //!   crack-front vertex along its in-plane normal, and the point failure
 //!   as it is. Tests: `nonlocal_criterion_switches` (below),
 //!   `tests/fracture.rs` (the average, the band, the speed limit, torn
@@ -536,7 +539,8 @@ pub struct FractureParameters {
     /// With `"nonlocal_damage"`: the width `w` of the material's shear
     /// band, m, in (0, `nonlocal_radius`]: a crack grows where
     /// `D̄ ≥ w / L` (at most 1), `L = 5πℓ/16` the width over which the bell
-    /// weight averages a thin band ([`NonlocalWeight::band_critical_damage`]),
+    /// weight averages a thin band (`32ℓ/35` with `nonlocal_weight =
+    /// "ball"`; [`NonlocalWeight::band_critical_damage`]),
     /// i.e. where the damage integrated across the band reaches that of a
     /// band of width `w` at `D = 1`: the band's slip at fracture. `w ≥ L`
     /// gives the locus as it stands, `D̄ ≥ 1`. Default 0.2 mm, the order of

@@ -19,12 +19,12 @@
 //! A crack grows where `D̄ ≥ 1` — the locus as it stands, no critical
 //! value fitted to ballistic results ([`CRITICAL_DAMAGE`]) — or, with a
 //! band width `w` (`band_width`), where `D̄ ≥ w/L`
-//! ([`NonlocalWeight::band_critical_damage`]): a band of width `w ≪ ℓ` at damage `D`
-//! averages to `D w/L`, `L = 5πℓ/16` ([`NonlocalWeight::band_averaging_width`]), so the
-//! criterion asks the damage integrated across the band, `∫ D dn`, to
-//! reach `w` — the slip of a band of the material's width at `D = 1`,
-//! however many rows the discretized band spreads over, as long as `ℓ`
-//! covers it.
+//! ([`NonlocalWeight::band_critical_damage`]): a band of width `w ≪ ℓ`
+//! at damage `D` averages to `D w/L`, `L = 5πℓ/16`
+//! ([`NonlocalWeight::band_averaging_width`]), so the criterion asks
+//! the damage integrated across the band, `∫ D dn`, to reach `w` — the
+//! slip of a band of the material's width at `D = 1`, however many rows
+//! the discretized band spreads over, as long as `ℓ` covers it.
 //!
 //! Why an average: the Johnson–Cook model has no length, and the shear
 //! band under the projectile's corner is as narrow as the discretization
@@ -44,14 +44,14 @@
 //! section), whose weight is the 3D one integrated along the hoop: a
 //! Gaussian stays itself, but the bell `(1 − r²/ℓ²)²` becomes
 //! `∝ (1 − ρ²/ℓ²)^{5/2}`, whose band width is the ball's `32ℓ/35`, not
-//! the section bell's `5πℓ/16` ([`NonlocalWeight::band_averaging_width`]). So a 3D model
-//! with the same `ℓ` and `w` asks a 7.4 % higher average (0.219 against
-//! 0.204); `docs/design-3d.md` §6.3 says how to keep the two the same,
-//! and `nonlocal_weight = "ball"` ([`NonlocalWeight`]) averages a 2D run
-//! with the 3D model's weight.
-//! The weight table is then a 3D neighbour list over Gauss points within
-//! `ℓ`, cut by crack surfaces instead of segments (a sight line crossing
-//! a crack triangle); the locus is unchanged.
+//! the section bell's `5πℓ/16` ([`NonlocalWeight::band_averaging_width`]).
+//! So a 3D model with the same `ℓ` and `w` asks a 7.4 % higher average
+//! (0.219 against 0.204); `docs/design-3d.md` §6.3 says how to keep the
+//! two the same, and `nonlocal_weight = "ball"` ([`NonlocalWeight`])
+//! averages a 2D run with the 3D model's weight. The weight table is
+//! then a 3D neighbour list over Gauss points within `ℓ`, cut by crack
+//! surfaces instead of segments (a sight line crossing a crack
+//! triangle); the locus is unchanged.
 //!
 //! **`ℓ` and `w`.** `ℓ` (default 1.0 mm) is an averaging length, not
 //! the band's: it must cover the band the coarsest lattice forms (about
