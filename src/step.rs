@@ -194,17 +194,17 @@ pub struct FastestParticle {
 
 impl FastestParticle {
     /// For a run summary: "534.0 m/s, particle 114144 (a crack-face
-    /// particle of 1.690e-6 kg from (9.877, 10.200) mm) at (12.43, 14.73)
-    /// mm, t = 14.880 us".
+    /// particle from (9.877, 10.200) mm, mass 1.690e-6 kg; kg/m in plane
+    /// strain) at (12.43, 14.73) mm, t = 14.880 us".
     pub fn describe(&self) -> String {
         format!(
-            "{:.1} m/s, particle {} ({} of {:.3e} kg from ({:.3}, {:.3}) mm) at ({:.2}, {:.2}) mm, t = {:.3} us",
+            "{:.1} m/s, particle {} ({} from ({:.3}, {:.3}) mm, mass {:.3e} kg; kg/m in plane strain) at ({:.2}, {:.2}) mm, t = {:.3} us",
             self.speed,
             self.particle,
             if self.crack_face { "a crack-face particle" } else { "a particle" },
-            self.mass,
             self.reference.x * 1e3,
             self.reference.y * 1e3,
+            self.mass,
             self.position.x * 1e3,
             self.position.y * 1e3,
             self.time * 1e6
