@@ -328,11 +328,19 @@ impl EdgePhase {
     /// mm)".
     pub fn describe(&self) -> String {
         format!(
-            "the projectile's edge (x = {:.3} mm) lies {:+.2} of a spacing from the target's nearest particle column (x = {:.3} mm)",
+            "the projectile's edge (x = {:.3} mm) lies {} of a spacing from the target's nearest particle column (x = {:.3} mm)",
             self.edge * 1e3,
-            self.offset,
+            self.offset_text(),
             self.column * 1e3
         )
+    }
+
+    /// The offset as the reports print it, "+0.18": signed, two decimals,
+    /// and "+0.00" for one that rounds to zero whatever its sign (a column
+    /// on the edge up to round-off).
+    pub fn offset_text(&self) -> String {
+        let offset = if self.offset.abs() < 0.005 { 0.0 } else { self.offset };
+        format!("{offset:+.2}")
     }
 }
 
@@ -1290,13 +1298,13 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
             });
             csv.push_str(&format!(",{}", vr.map_or(String::new(), |x| format!("{x:.3}"))));
         }
-        let edge = r.edge.map(|e| e.offset);
         md.push_str(&format!(
             " {} | {wall:.0} | {} |\n",
             st.shots.len(),
-            edge.map_or("—".into(), |o| format!("{o:+.2}"))
+            r.edge.map_or("—".into(), |e| e.offset_text())
         ));
-        csv.push_str(&format!(",{},{wall:.2},{}\n", st.shots.len(), edge.map_or(String::new(), |o| format!("{o:.4}"))));
+        let edge = r.edge.map_or(String::new(), |e| format!("{:.4}", e.offset));
+        csv.push_str(&format!(",{},{wall:.2},{edge}\n", st.shots.len()));
     }
     let pct = |s: Option<Real>| s.map_or("—".into(), |x| format!("{:.1} %", 100.0 * x));
     let limits: Vec<Real> = rungs.iter().filter_map(|r| limit_of(&r.study).map(|e| e.0)).collect();
@@ -1729,6 +1737,12 @@ mod tests {
         refined.bodies[0].rectangle.column_at = Some(0.01);
         assert!(edge_phase(&refined, Projectile::Rigid(0)).unwrap().offset.abs() < 1e-9);
         assert!(edge_phase(&refined, Projectile::Rigid(0)).unwrap().describe().contains("+0.00 of a spacing"));
+        // a column on the edge up to round-off, from either side
+        for offset in [-1e-15, 1e-15, -0.004] {
+            let e = EdgePhase { edge: 0.01, column: 0.01, offset };
+            assert!(e.describe().contains(" lies +0.00 of a spacing"), "{}", e.describe());
+        }
+        assert!(EdgePhase { edge: 0.01, column: 0.01, offset: -0.006 }.describe().contains(" lies -0.01 of"));
     }
 
     #[test]
