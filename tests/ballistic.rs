@@ -563,16 +563,14 @@ fn check_and_run_state_the_projectile_s_edge_against_the_columns() {
     let dir = fresh_dir("rim");
     let case = dir.join("small.toml");
     std::fs::write(&case, small_plate()).unwrap();
-    let plugsim =
-        |args: &[&str]| std::process::Command::new(env!("CARGO_BIN_EXE_plugsim")).args(args).output().unwrap();
     let width = "rigid_bodies.projectile.rectangle.width=0.0086";
     let line = "the projectile's edge (x = 4.300 mm) lies -0.40 of a spacing from the target's nearest particle column (x = 4.500 mm)";
-    let o = plugsim(&["check", case.to_str().unwrap(), "--set", width]);
+    let o = common::plugsim(&["check", case.to_str().unwrap(), "--set", width]);
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(stdout.contains(&format!("  rim             {line}")), "{stdout}");
     let out = dir.join("run");
-    let o = plugsim(&[
+    let o = common::plugsim(&[
         "--threads",
         "1",
         "run",
@@ -587,14 +585,14 @@ fn check_and_run_state_the_projectile_s_edge_against_the_columns() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success() && stderr.contains(&format!("plugsim: {line}")), "{stderr}");
     // On a column: +0.00 (the shared case's 8 mm projectile, edge at 4 mm).
-    let o = plugsim(&["check", case.to_str().unwrap()]);
+    let o = common::plugsim(&["check", case.to_str().unwrap()]);
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(
         stdout.contains("lies +0.00 of a spacing from the target's nearest particle column (x = 4.000 mm)"),
         "{stdout}"
     );
     // No projectile, no line.
-    let o = plugsim(&["check", "--case", "elastic-strike"]);
+    let o = common::plugsim(&["check", "--case", "elastic-strike"]);
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success() && !stdout.contains("rim "), "{stdout}");
     std::fs::remove_dir_all(&dir).ok();

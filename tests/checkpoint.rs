@@ -3,6 +3,9 @@
 //! the run that was never stopped; checkpoints of another format version,
 //! damaged or truncated files are refused with a message that says so.
 
+mod common;
+
+use common::plugsim;
 use plugsim::case::Case;
 use plugsim::checkpoint::{self, RunProgress, FORMAT_VERSION};
 use plugsim::run::{build_simulation, execute, resume, Progress, RunConfig, RunError, RunInfo};
@@ -452,10 +455,6 @@ fn a_fresh_run_removes_the_checkpoints_of_an_earlier_run_in_its_directory() {
     run_until(&case1, &dir, 4);
     run_through(&case1, &dir);
     assert!(checkpoint::list(&checkpoint::directory(&dir)).is_empty());
-}
-
-fn plugsim(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_plugsim")).args(args).output().unwrap()
 }
 
 fn history_rows(dir: &Path) -> usize {

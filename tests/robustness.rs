@@ -5,6 +5,9 @@
 //! fuzzer over mutated case files finds no panic in the path of
 //! `plugsim check`.
 
+mod common;
+
+use common::plugsim;
 use plugsim::case::Case;
 use plugsim::cases::BUILTIN_CASES;
 use proptest::prelude::*;
@@ -17,10 +20,6 @@ fn scratch(name: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
-}
-
-fn plugsim(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_plugsim")).args(args).output().unwrap()
 }
 
 /// The run failed, without a panic, with exactly one line on stderr; returns it.

@@ -22,6 +22,13 @@ poisson_ratio = 0.3
     };
 }
 
+/// Run the built `plugsim` command line with `args`: its exit status and
+/// output (the command-line tests).
+#[allow(dead_code)] // not every test binary uses every helper
+pub fn plugsim(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_plugsim")).args(args).output().unwrap()
+}
+
 /// A 4 mm plate and a blunt 8 mm projectile at 400 m/s with cracks
 /// (`small_impact.toml`), 12 µs: the fracture and ballistic tests' impact.
 #[allow(dead_code)] // not every test binary uses every helper
