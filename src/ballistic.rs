@@ -468,6 +468,9 @@ pub struct Shot {
     /// erode_failed_below`).
     #[serde(default)]
     pub floor_eroded: u64,
+    /// Particles detached from their body (0 without it, `fracture.detach_below`).
+    #[serde(default)]
+    pub detached: usize,
 }
 
 impl Shot {
@@ -872,6 +875,7 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
                 dir,
                 added_mass: s.mass_scaling.map_or(0.0, |a| a.mass),
                 floor_eroded: s.floor_eroded.unwrap_or(0),
+                detached: s.detached.len(),
             };
             let kept = FinishedRun { writer: crate::checkpoint::this_writer(), shot: shot.clone() };
             // Not written (a full disk): `--resume` runs it again; the table has it.
@@ -1169,6 +1173,14 @@ pub fn report(header: &str, study: &Study) -> String {
             "Erosion at the step's floor (`time.erode_failed_below`, not in SPEC §5) eroded fractured points to hold \
              the step: at most {} in one run, at {:.2} m/s; each run's summary gives its own.\n\n",
             most.floor_eroded, most.speed
+        ));
+    }
+    if let Some(most) = study.shots.iter().filter(|x| x.detached > 0).max_by_key(|x| x.detached) {
+        s.push_str(&format!(
+            "Detached particles (`fracture.detach_below`, not in SPEC §9): erosion left particles without material, \
+             and they left their body's shape functions: at most {} in one run, at {:.2} m/s; each run's summary \
+             names them.\n\n",
+            most.detached, most.speed
         ));
     }
     s.push_str(&format!("{DEFINITIONS}\n\n![v_r against v_i](ballistic.png)\n"));
@@ -1542,6 +1554,7 @@ mod tests {
             wall: 0.0,
             added_mass: 0.0,
             floor_eroded: 0,
+            detached: 0,
             dir: PathBuf::new(),
         }
     }
@@ -1611,8 +1624,8 @@ mod tests {
         assert_eq!(Study { shots: vec![], limit: None, ..study.clone() }.limit_reading(), None);
     }
 
-    /// The step's floors are named in the report, each with its largest
-    /// run, and only where they acted.
+    /// The step's floors and the detached particles are named in the
+    /// report, each with its largest run, and only where they acted.
     #[test]
     fn the_report_names_the_steps_floors_where_they_acted() {
         let perf = |v| Verdict::Perforated { residual: v, since: 0.0 };
@@ -1625,12 +1638,20 @@ mod tests {
             fit: None,
         };
         let text = report("header", &study(&shots));
-        assert!(!text.contains("mass_scaling") && !text.contains("erode_failed_below"), "{text}");
+        assert!(
+            !text.contains("mass_scaling") && !text.contains("erode_failed_below") && !text.contains("detach_below"),
+            "{text}"
+        );
         shots[0].added_mass = 2e-5;
         shots[1].added_mass = 7e-5;
         shots[1].floor_eroded = 3;
         shots[2].floor_eroded = 12;
+        shots[0].detached = 2;
         let text = report("header", &study(&shots));
+        assert!(
+            text.contains("`fracture.detach_below`") && text.contains("at most 2 in one run, at 150.00 m/s"),
+            "{text}"
+        );
         assert!(text.contains("at most 7.0000e-5 kg") && text.contains("in the run at 170.00 m/s"), "{text}");
         assert!(
             text.contains("`time.erode_failed_below`") && text.contains("at most 12 in one run, at 190.00 m/s"),

@@ -148,8 +148,11 @@ pub const MAGIC: [u8; 8] = *b"PLUGCKPT";
 /// ([`crate::stability::StableStep::eroded`]), version 14 the fastest
 /// particle's reference position, mass and crack-face flag
 /// ([`crate::step::FastestParticle`]) and the non-local average's weight
-/// ([`crate::fracture::FractureParameters::nonlocal_weight`]).
-pub const FORMAT_VERSION: u32 = 14;
+/// ([`crate::fracture::FractureParameters::nonlocal_weight`]), version 15
+/// the detached particles and the points their search has seen eroded
+/// ([`crate::fracture::CrackGrowth::detach_isolated`]) and the kinetic
+/// energy the crack changes moved ([`crate::step::Energies::crack_changes`]).
+pub const FORMAT_VERSION: u32 = 15;
 /// Subdirectory of a run's output directory that holds its checkpoints.
 pub const DIRECTORY: &str = "checkpoints";
 /// File name extension of a checkpoint.

@@ -1055,6 +1055,12 @@ fn drive(
         100.0 * s.energies.drift(),
         100.0 * s.max_drift
     );
+    if s.energies.crack_changes != 0.0 {
+        println!(
+            "  crack changes: the splits' and detachments' re-lumped masses and momentum correction took out {:.4e} J of kinetic energy (in the energy balance)",
+            s.energies.crack_changes
+        );
+    }
     if s.bulk_viscosity.is_active() {
         println!(
             "  bulk viscosity: linear {}, quadratic {} (not in SPEC §5; its work is in the internal energy)",
@@ -1132,6 +1138,15 @@ fn drive(
         println!(
             "  eroded: {} quadrature points inverted after meeting the crack criterion, were torn open after fracturing, or were eroded at the step's floor, and carry no stress (history.csv: eroded_points)",
             s.eroded_points
+        );
+    }
+    if !s.detached.is_empty() {
+        let shown: Vec<String> = s.detached.iter().take(8).map(|(i, t)| format!("{i} at {:.3} us", t * 1e6)).collect();
+        let more = if s.detached.len() > 8 { ", ..." } else { "" };
+        println!(
+            "  detached: {} particles (erosion left them less than fracture.detach_below of their material; they fly free with their mass): {}{more}",
+            s.detached.len(),
+            shown.join(", ")
         );
     }
     if let Some(n) = s.floor_eroded {

@@ -25,6 +25,10 @@ impl ParticleFlags {
     pub const SLAVE: u8 = 16;
     /// On the symmetry axis (axisymmetry).
     pub const ON_AXIS: u8 = 32;
+    /// Detached from its body: erosion left it (almost) no material of its
+    /// own, and no shape function holds it any more; it flies free with
+    /// its mass (`crate::fracture::CrackGrowth::detach_isolated`).
+    pub const DETACHED: u8 = 64;
 
     #[inline]
     pub fn has(self, f: u8) -> bool {

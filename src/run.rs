@@ -134,6 +134,11 @@ pub struct RunSummary {
     /// (`[time] erode_failed_below`, [`crate::stability::StableStep::eroded`]);
     /// `None` without it.
     pub floor_eroded: Option<u64>,
+    /// Particles that erosion left without material and that were detached
+    /// from their body (`fracture.detach_below`,
+    /// [`crate::fracture::CrackGrowth::detach_isolated`]) and when, s, in
+    /// order.
+    pub detached: Vec<(usize, Real)>,
     /// Particles that joined the contact slaves by exposure, and when they
     /// touched a rigid body ([`crate::contact::ContactSystem::admit_exposed`]).
     pub exposed: crate::output::ExposedSummary,
@@ -556,6 +561,7 @@ fn time_loop(
         plug,
         eroded_points: sim.model.quad.eroded.iter().filter(|&&e| e).count(),
         floor_eroded: sim.floors.erosion.and(sim.stable.as_ref()).map(|s| s.eroded),
+        detached: sim.cracks.as_ref().map_or_else(Vec::new, |c| c.detached.clone()),
         exposed: crate::output::exposed_contact_summary(&history),
         cracks,
         tip_damage,

@@ -48,13 +48,23 @@ pub struct Energies {
     /// Kinetic energy taken out by mass scaling, which adds mass at rest
     /// ([`crate::stability::StableStep::evaluate`]; 0 without it).
     pub mass_scaling: Real,
+    /// Kinetic energy taken out by the crack stage's changes: a split's or
+    /// a detachment's re-lumped masses, momentum correction and rebuilt
+    /// internal force move the full-step kinetic energy
+    /// (`Simulation::full_step_kinetic_terms`) without any work; summed
+    /// over the changes, the estimate before less the estimate after
+    /// (`Simulation::grow_cracks`; 0 without cracks).
+    pub crack_changes: Real,
 }
 
 impl Energies {
-    /// `kinetic + rigid_kinetic + internal − (contact_work + rigid_work)
-    /// + mass_scaling`: stays at `initial_kinetic` in an exact integration.
+    /// `kinetic + rigid_kinetic + internal − (contact_work + rigid_work)`
+    /// `+ mass_scaling + crack_changes`: stays at `initial_kinetic` in an
+    /// exact integration.
     pub fn total(&self) -> Real {
-        self.kinetic + self.rigid_kinetic + self.internal - (self.contact_work + self.rigid_work) + self.mass_scaling
+        self.kinetic + self.rigid_kinetic + self.internal - (self.contact_work + self.rigid_work)
+            + self.mass_scaling
+            + self.crack_changes
     }
     /// Energy dissipated by the contact algorithm, `−(contact_work + rigid_work)`.
     pub fn contact_dissipation(&self) -> Real {
@@ -435,16 +445,26 @@ impl Simulation {
             return Ok(false);
         };
         let (step, time) = (self.step + 1, self.time + dt);
-        let faces = cracks.grow(&mut self.model, time, step).map_err(|source| SolverError::Fracture {
-            source: Box::new(source),
-            step,
-            time,
-        })?;
-        if faces.is_empty() {
+        if cracks.params.critical_value().is_none() {
             return Ok(false);
         }
-        self.crack_faces_changed(&faces);
+        // The full-step kinetic energy before any change, to book what the
+        // changes move (`Energies::crack_changes`).
+        let before = self.full_step_kinetic();
+        let cracks = self.cracks.as_mut().expect("checked above");
+        let fracture_error = |source| SolverError::Fracture { source: Box::new(source), step, time };
+        let faces = cracks.grow(&mut self.model, time, step).map_err(fracture_error)?;
+        // Particles that erosion (this step's, or the grown cracks') left
+        // without material leave the shape functions.
+        let detached = cracks.detach_isolated(&mut self.model, time).map_err(fracture_error)?;
+        if faces.is_empty() && detached.is_empty() {
+            return Ok(false);
+        }
+        if !faces.is_empty() {
+            self.crack_faces_changed(&faces);
+        }
         internal_force(&mut self.model);
+        self.energies.crack_changes += before - self.full_step_kinetic();
         Ok(true)
     }
 
@@ -581,6 +601,13 @@ impl Simulation {
                 constrain(*flags, &mut acc);
                 *e = 0.5 * m * (v + acc * half).norm_squared();
             });
+    }
+
+    /// The full-step kinetic energy of the particles as they are now
+    /// ([`Simulation::full_step_kinetic_terms`], summed in index order).
+    fn full_step_kinetic(&mut self) -> Real {
+        self.full_step_kinetic_terms();
+        self.kinetic_scratch.iter().sum()
     }
 
     /// Deformation and velocity gradients, material update, `P w`.

@@ -276,6 +276,26 @@ const FRACTURE_SETS: &[&str] = &[
 ];
 const FRACTURE_STOP: u64 = 30;
 
+/// Detached particles across the checkpoint (`fracture.detach_below`):
+/// in the fracture test's plate run on to 40 µs, one particle is detached
+/// before the checkpoint and one after it; the resumed run equals the
+/// uninterrupted one, the detached particles and when included.
+#[test]
+fn resumed_run_with_detached_particles_is_bit_identical() {
+    let mut sets: Vec<&str> =
+        FRACTURE_SETS.iter().copied().filter(|s| !s.starts_with("time.end") && !s.starts_with("checkpoint")).collect();
+    sets.extend(["time.end=4e-5", "checkpoint.interval=2.5e-5", "fracture.detach_below=0.5"]);
+    let case = case(BORVIK_FRACTURE, &sets);
+    let (from, end) = kill_and_resume("detach", &case, 190);
+    let (before, after) = (&from.cracks.as_ref().unwrap().detached, &end.cracks.as_ref().unwrap().detached);
+    assert!(
+        !before.is_empty() && after.len() > before.len(),
+        "detached {before:?} by the checkpoint, {after:?} at the end"
+    );
+    assert_eq!(&after[..before.len()], &before[..]);
+    assert!(after.iter().all(|&(i, _)| end.model.particles.flags[i].has(plugsim::particles::ParticleFlags::DETACHED)));
+}
+
 /// The crack log round-trips bit for bit, NaN payloads and −0.0 included.
 #[test]
 fn crack_state_round_trips_bit_for_bit() {
@@ -402,20 +422,20 @@ fn checkpoint_of_another_format_version_is_refused_naming_both() {
     }
 }
 
-/// Format 13 (postcard, before the fastest particle's reference position,
-/// mass and crack-face flag and the non-local average's weight) is
-/// refused, naming both versions, rather than misread.
+/// Format 14 (postcard, before the detached particles, the points their
+/// search has seen eroded and the crack changes' kinetic energy) is refused, naming both versions, rather
+/// than misread.
 #[test]
 fn older_format_version_checkpoint_is_refused_naming_both_versions() {
-    assert_eq!(FORMAT_VERSION, 14);
+    assert_eq!(FORMAT_VERSION, 15);
     let case = case(STRIKE, &["time.end=1e-6"]);
-    let dir = scratch("version-13");
+    let dir = scratch("version-14");
     let path = run_until(&case, &dir, 2);
-    corrupt(&path, 8, &13u32.to_le_bytes());
+    corrupt(&path, 8, &14u32.to_le_bytes());
     let e = checkpoint::read(&path).unwrap_err().to_string();
-    assert!(e.contains("format version 13 ") && e.contains("reads format version 14"), "{e}");
+    assert!(e.contains("format version 14 ") && e.contains("reads format version 15"), "{e}");
     let e = resume(&config(&dir, None), &mut |_| {}).unwrap_err().to_string();
-    assert!(e.contains("format version 13 ") && e.contains("format version 14"), "{e}");
+    assert!(e.contains("format version 14 ") && e.contains("format version 15"), "{e}");
 }
 
 #[test]

@@ -1313,3 +1313,148 @@ fn a_tip_that_reaches_another_crack_joins_it() {
     assert!(g.events[events..].iter().all(|e| e.kind != EventKind::Join), "{:?}", &g.events[events..]);
     assert_eq!(g.cracks[1].tip, Some(id(&m, 8, 4)), "waits for the criterion");
 }
+
+/// A particle that erosion has left (almost) without material is an
+/// eroded element's free node (`fracture.detach_below`,
+/// `CrackGrowth::detach_isolated`). In a deformed, moving plate the
+/// points around its centre are eroded; every particle whose share of
+/// material at live points (by hand from the table's rows, `Σ |N| ρ w`)
+/// is under 0.1 — and only those — is detached: it is in no row of
+/// either table, so it takes no internal force, and it keeps its mass
+/// and velocity; the total mass and the momentum are kept; every point's
+/// deformation gradient (the shape part plus the carried jump) is
+/// unchanged, so no stress jumps; its own particle row is itself alone
+/// (its displacement is its own). Stepped on, it flies at its velocity.
+/// With `detach_below = 0` nothing is detached.
+#[test]
+fn isolated_particles_are_detached_and_fly_free() {
+    let centre = Vec2::new(5.0 * H, 5.0 * H);
+    let setup = |detach_below: Real| {
+        let mut m = plate(11, 11);
+        for i in 0..m.particles.len() {
+            let x = m.particles.x0[i] - centre;
+            m.particles.u[i] = Vec2::new(1e-3 * x.x + 2e-3 * x.y, -0.5e-3 * x.y);
+            m.particles.v[i] = Vec2::new(3.0 + 1e3 * x.y, -2.0 + 5e2 * x.x);
+        }
+        for q in 0..m.quad.len() {
+            if (m.quad.x0[q] - centre).norm() < 2.2 * H {
+                m.quad.eroded[q] = true;
+            }
+        }
+        let cracks = CrackGrowth::new(FractureParameters { detach_below, ..params(Criterion::Damage) });
+        (m, cracks)
+    };
+    let (mut m, mut cracks) = setup(0.1);
+    // The share by hand, from the rows.
+    let n = m.particles.len();
+    let (mut live, mut all) = (vec![0.0; n], vec![0.0; n]);
+    for q in 0..m.quad.len() {
+        for k in m.qp_shape.range(q) {
+            let i = m.qp_shape.index[k] as usize;
+            let w = 7850.0 * m.qp_shape.value[k].abs() * m.quad.weight[q];
+            all[i] += w;
+            if !m.quad.eroded[q] {
+                live[i] += w;
+            }
+        }
+    }
+    let expected: Vec<usize> = (0..n).filter(|&i| live[i] < 0.1 * all[i]).collect();
+    let middle = (0..n).min_by(|&a, &b| {
+        (m.particles.x0[a] - centre).norm().partial_cmp(&(m.particles.x0[b] - centre).norm()).unwrap()
+    });
+    assert!(expected.contains(&middle.unwrap()), "{expected:?}");
+    let (mass0, momentum0) = (m.particles.mass.clone(), m.particles.momentum());
+    let f_before: Vec<_> = (0..m.quad.len()).map(|q| m.shape_deformation_gradient(q) + m.quad.f_carry_of(q)).collect();
+    let detached = cracks.detach_isolated(&mut m, 0.0).unwrap();
+    eprintln!("detached {detached:?} of {n}");
+    assert_eq!(detached, expected);
+    assert_eq!(cracks.detached, expected.iter().map(|&i| (i, 0.0)).collect::<Vec<_>>());
+    for &i in &detached {
+        assert!(m.particles.flags[i].has(ParticleFlags::DETACHED));
+        assert_eq!(m.particles.mass[i], mass0[i], "a detached particle keeps its mass");
+        assert!(!m.qp_shape.index.contains(&(i as u32)));
+        // Its own particle row is itself; no other row holds it.
+        let ps = &m.particle_shape;
+        assert!((0..ps.rows()).all(|r| r == i || !ps.range(r).any(|k| ps.index[k] == i as u32)));
+        let own = ps.range(i);
+        assert_eq!((own.len(), ps.index[own.start], ps.value[own.start]), (1, i as u32, 1.0));
+        assert_eq!(ps.grad[own.start], Vec2::zeros());
+    }
+    let total: Real = mass0.iter().sum();
+    assert!((m.particles.total_mass() - total).abs() < 1e-12 * total);
+    let dp = (m.particles.momentum() - momentum0).norm();
+    assert!(dp < 1e-12 * momentum0.norm(), "momentum moved by {dp:e}");
+    for (q, before) in f_before.iter().enumerate() {
+        let after = m.shape_deformation_gradient(q) + m.quad.f_carry_of(q);
+        assert!((after - before).norm() < 1e-12, "point {q}: F moved by {:e}", (after - before).norm());
+    }
+    // No more erosion, no more detaching.
+    assert!(cracks.detach_isolated(&mut m, 0.0).unwrap().is_empty());
+    // Stepped on: no internal force on the detached particles, which keep
+    // their velocity (no contact, no load).
+    let v0: Vec<Vec2> = detached.iter().map(|&i| m.particles.v[i]).collect();
+    let mut sim = Simulation::new(m, TimeStepRule::Cfl { safety: 0.5 });
+    sim.cracks = Some(cracks);
+    for _ in 0..5 {
+        sim.step().unwrap();
+    }
+    for (&i, v) in detached.iter().zip(&v0) {
+        assert_eq!(sim.model.particles.f_int[i], Vec2::zeros());
+        assert!((sim.model.particles.v[i] - v).norm() < 1e-12 * v.norm(), "particle {i}");
+    }
+    // Off: nothing detached.
+    let (mut m, mut cracks) = setup(0.0);
+    assert!(cracks.detach_isolated(&mut m, 0.0).unwrap().is_empty());
+    assert!(m.particles.flags.iter().all(|f| !f.has(ParticleFlags::DETACHED)));
+}
+
+/// The energy balance books what the crack stage's changes move
+/// (`Energies::crack_changes`): a split re-lumps masses and corrects the
+/// momentum, which changes the kinetic energy with no work done. In a
+/// spinning plate (no load, no contact) with a failed column, cracks
+/// nucleate and run; at every step with a crack change the balance's
+/// total moves by no more than at the steps without one, while the
+/// booked changes are many times that, so without them the balance would
+/// jump at each split.
+#[test]
+fn the_energy_balance_books_the_crack_changes() {
+    let (nx, ny) = (11, 21);
+    let mut m = plate(nx, ny);
+    let centre = Vec2::new(5.0 * H, 10.0 * H);
+    let omega = 4000.0;
+    for i in 0..m.particles.len() {
+        let r = m.particles.x0[i] - centre;
+        m.particles.v[i] = Vec2::new(-omega * r.y, omega * r.x);
+    }
+    for q in 0..m.quad.len() {
+        m.quad.damage[q] = if (m.quad.x0[q].x - 5.0 * H).abs() < 0.6 * H { 5.0 } else { 0.0 };
+    }
+    let mut sim = Simulation::new(m, TimeStepRule::Cfl { safety: 0.5 });
+    sim.cracks = Some(CrackGrowth::new(params(Criterion::Damage)));
+    let (mut quiet, mut booked_steps) = (Vec::new(), Vec::new());
+    for _ in 0..40 {
+        let (total, booked, events) =
+            (sim.energies.total(), sim.energies.crack_changes, sim.cracks.as_ref().unwrap().events.len());
+        sim.step().unwrap();
+        let d_total = (sim.energies.total() - total).abs();
+        let d_booked = sim.energies.crack_changes - booked;
+        if sim.cracks.as_ref().unwrap().events.len() > events {
+            booked_steps.push((d_total, d_booked));
+        } else {
+            assert_eq!(d_booked, 0.0, "booked without a crack change");
+            quiet.push(d_total);
+        }
+    }
+    let quiet_max = quiet.iter().cloned().fold(0.0, Real::max);
+    let kinetic = sim.energies.initial_kinetic;
+    eprintln!("quiet steps: |Δtotal| ≤ {quiet_max:.3e} J of {kinetic:.3e} J; crack steps (|Δtotal|, booked): {booked_steps:?}");
+    assert!(booked_steps.len() >= 3 && !quiet.is_empty(), "{} crack steps", booked_steps.len());
+    let largest_booked = booked_steps.iter().map(|b| b.1.abs()).fold(0.0, Real::max);
+    assert!(largest_booked > 20.0 * quiet_max, "booked {largest_booked:e} against quiet drift {quiet_max:e}");
+    for &(d_total, d_booked) in &booked_steps {
+        assert!(
+            d_total <= 2.0 * quiet_max + 1e-3 * d_booked.abs(),
+            "Δtotal {d_total:e} at a crack step booking {d_booked:e}"
+        );
+    }
+}

@@ -17,7 +17,7 @@ use crate::model::{Gather, Model};
 use crate::neighbors::CellGrid;
 use crate::particles::{FaceSide, ParticleFlags};
 use crate::shape::ShapeTable;
-use crate::shape::{rebuild_rows, Basis};
+use crate::shape::{rebuild_rows, splice_rows, Basis, Row};
 use nalgebra::Matrix2;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -365,6 +365,12 @@ pub struct CrackGrowth {
     /// configuration). Not in checkpoints.
     #[serde(skip)]
     nonlocal: OnceLock<NonlocalAverage>,
+    /// The quadrature points found eroded so far by
+    /// [`CrackGrowth::detach_isolated`]: those eroded since are the new
+    /// ones whose particles it looks at.
+    eroded_seen: Vec<bool>,
+    /// The particles detached so far and when, s, in order.
+    pub detached: Vec<(usize, Real)>,
 }
 
 /// See [`CrackGrowth::spare`].
@@ -433,6 +439,8 @@ impl CrackGrowth {
             spare: Spare::default(),
             last_time: None,
             nonlocal: OnceLock::new(),
+            eroded_seen: Vec::new(),
+            detached: Vec::new(),
         }
     }
 
@@ -686,7 +694,7 @@ impl CrackGrowth {
             // (rank, criterion value, particle)
             let mut best: Option<(Real, Real, usize)> = None;
             for &j in &circle {
-                if model.particles.flags[j].has(ParticleFlags::CRACK_FACE) {
+                if model.particles.flags[j].has(ParticleFlags::CRACK_FACE | ParticleFlags::DETACHED) {
                     continue;
                 }
                 let r = model.particles.x0[j] - xt;
@@ -858,7 +866,7 @@ impl CrackGrowth {
                 // The axis is a boundary of the r-z section but no surface
                 // of the body: no crack starts there.
                 f.has(ParticleFlags::SLAVE)
-                    && !f.has(ParticleFlags::CRACK_FACE)
+                    && !f.has(ParticleFlags::CRACK_FACE | ParticleFlags::DETACHED)
                     && !f.has(ParticleFlags::ON_AXIS)
                     && model.particles.x0[i].x >= min_radius
                     && self.may_reach(model, i, critical, maxima.as_deref())
@@ -1244,6 +1252,48 @@ impl CrackGrowth {
         Ok((l, r))
     }
 
+    /// Detach the particles that erosion has left without material
+    /// (`detach_below`; module doc, "Detached particles"): after points
+    /// were eroded, each particle in their rows whose share of its
+    /// material at points not eroded, `Σ_live |N_I| ρ w / Σ |N_I| ρ w`, is
+    /// below `detach_below` is flagged [`ParticleFlags::DETACHED`] and the
+    /// rows around it are rebuilt without it (`Self::rebuild_local`: the
+    /// deformation gradients carried over, the masses re-lumped with its
+    /// own kept, the momentum restored). The particles detached at `time`
+    /// (s), in index order.
+    pub fn detach_isolated(&mut self, model: &mut Model, time: Real) -> Result<Vec<usize>, FractureError> {
+        let threshold = self.params.detach_below;
+        let eroded = &model.quad.eroded;
+        self.eroded_seen.resize(eroded.len(), false);
+        if threshold <= 0.0 || eroded.iter().zip(&self.eroded_seen).all(|(e, s)| e == s) {
+            return Ok(Vec::new());
+        }
+        let mut near = std::collections::BTreeSet::new();
+        for (q, (&e, seen)) in eroded.iter().zip(self.eroded_seen.iter_mut()).enumerate() {
+            if e && !*seen {
+                *seen = true;
+                near.extend(model.qp_shape.range(q).map(|k| model.qp_shape.index[k] as usize));
+            }
+        }
+        let isolated: Vec<usize> = near
+            .into_iter()
+            .filter(|&i| !model.particles.flags[i].has(ParticleFlags::DETACHED) && live_share(model, i) < threshold)
+            .collect();
+        // All flagged first: a rebuild re-lumps the particles it touches,
+        // and one detached later must keep the mass it has now.
+        for &i in &isolated {
+            model.particles.flags[i].set(ParticleFlags::DETACHED);
+        }
+        for &i in &isolated {
+            let momentum = model.particles.momentum();
+            let (x, body) = (model.particles.x0[i], model.particles.body[i]);
+            self.rebuild_local(model, body, x, x, momentum)
+                .map_err(|source| FractureError::Detach { particle: i, source })?;
+        }
+        self.detached.extend(isolated.iter().map(|&i| (i, time)));
+        Ok(isolated)
+    }
+
     /// Rebuild the binned opaque segments from the cracks, in cells of the
     /// largest support of `model`.
     pub fn refresh_segments(&mut self, model: &Model) {
@@ -1287,14 +1337,15 @@ impl CrackGrowth {
             let end = *ps.offsets.last().expect("offsets start at 0");
             ps.offsets.push(end);
         }
-        let rows_p: Vec<usize> =
-            (0..n).filter(|&i| model.particles.body[i] == body && inside(&model.particles.x0[i])).collect();
+        let (rows_p, detached): (Vec<usize>, Vec<usize>) = (0..n)
+            .filter(|&i| model.particles.body[i] == body && inside(&model.particles.x0[i]))
+            .partition(|&i| !model.particles.flags[i].has(ParticleFlags::DETACHED));
         // The RK deformation gradients before the change (module doc:
         // "deformation gradient across a crack change").
         let f_before: Vec<Tensor3> = rows_q.iter().map(|&q| model.shape_deformation_gradient(q)).collect();
         let p = &model.particles;
         let cracks = CrackVisibility { segments: &self.segments, x0: &p.x0, face_side: &p.face_side };
-        let vis = OwnBody { cracks, body_of: &p.body, body };
+        let vis = OwnBody { cracks, body_of: &p.body, flags: &p.flags, body };
         let mut qp_shape = std::mem::take(&mut model.qp_shape);
         let mut particle_shape = std::mem::take(&mut model.particle_shape);
         let spare = &mut self.spare;
@@ -1302,6 +1353,11 @@ impl CrackGrowth {
         let r1 = rebuild_rows(&mut qp_shape, &mut spare.qp_shape, &rows_q, qx, px, &p.support, &p.volume, &vis);
         let r2 =
             rebuild_rows(&mut particle_shape, &mut spare.particle_shape, &rows_p, px, px, &p.support, &p.volume, &vis);
+        // A detached particle moves by its own displacement alone: its
+        // row is itself, `N = 1`, `∇N = 0` (the rows of the others no
+        // longer see it).
+        let own: Vec<Row> = detached.iter().map(|&i| vec![(i as u32, 1.0, Vec2::zeros())]).collect();
+        splice_rows(&mut particle_shape, &mut spare.particle_shape, &detached, own);
         model.qp_shape = qp_shape;
         model.particle_shape = particle_shape;
         for (rows, reduced, map) in
@@ -1311,6 +1367,9 @@ impl CrackGrowth {
                 map.remove(r);
             }
             map.extend(reduced);
+        }
+        for r in &detached {
+            self.reduced_particle_rows.remove(r);
         }
         for (&q, before) in rows_q.iter().zip(&f_before) {
             let after = model.shape_deformation_gradient(q);
@@ -1328,8 +1387,15 @@ impl CrackGrowth {
         // Re-lumped: the material's mass; the mass scaling added
         // ([`crate::stability`]) stays on its particle.
         let before: Real = touched.iter().map(|&i| model.particles.mass[i] - model.particles.added_mass[i]).sum();
+        // Held at their mass: particles at the floor, and detached ones,
+        // which keep the material they had (no row holds them any more).
         let mut floored = Vec::new();
         for &i in &touched {
+            if model.particles.flags[i].has(ParticleFlags::DETACHED) {
+                floored.push(i);
+                model.particles.mass[i] -= model.particles.added_mass[i];
+                continue;
+            }
             let m = model.lumped_mass(i);
             let floor = MASS_FLOOR * nodal_mass(model, i);
             if m < floor {
@@ -1369,18 +1435,43 @@ impl CrackGrowth {
     }
 }
 
-/// The crack visibility within one body: the particles of other bodies are
-/// hidden ([`CrackGrowth::rebuild_local`]).
+/// The crack visibility within one body: the particles of other bodies,
+/// and detached ones ([`CrackGrowth::detach_isolated`]), are hidden
+/// ([`CrackGrowth::rebuild_local`]).
 struct OwnBody<'a> {
     cracks: CrackVisibility<'a>,
     body_of: &'a [u32],
+    flags: &'a [ParticleFlags],
     body: u32,
 }
 
 impl crate::shape::Visibility for OwnBody<'_> {
     #[inline]
     fn visible(&self, x: &Vec2, particle: usize) -> bool {
-        self.body_of[particle] == self.body && self.cracks.visible(x, particle)
+        self.body_of[particle] == self.body
+            && !self.flags[particle].has(ParticleFlags::DETACHED)
+            && self.cracks.visible(x, particle)
+    }
+}
+
+/// The share of particle `i`'s material at quadrature points that are
+/// not eroded: `Σ_live |N_I(X_q)| ρ w_q / Σ_q |N_I(X_q)| ρ w_q` over its
+/// gather (1 for a particle no point holds).
+pub fn live_share(model: &Model, i: usize) -> Real {
+    let (mut live, mut all) = (0.0, 0.0);
+    for j in model.gather.range(i) {
+        let q = model.gather.point[j] as usize;
+        let rho = model.materials[model.quad.body[q] as usize].density();
+        let m = rho * model.gather.value[j].abs() * model.quad.weight[q];
+        all += m;
+        if !model.quad.eroded[q] {
+            live += m;
+        }
+    }
+    if all > 0.0 {
+        live / all
+    } else {
+        1.0
     }
 }
 

@@ -331,10 +331,20 @@ pub fn rebuild_rows(
         .collect::<Result<_, _>>()?;
     let reduced: Vec<(usize, Basis)> =
         which.iter().zip(&built).filter(|(_, (_, b))| *b != Basis::Bilinear).map(|(&r, &(_, b))| (r, b)).collect();
+    splice_rows(table, spare, which, built.into_iter().map(|(row, _)| row).collect());
+    Ok(reduced)
+}
+
+/// Replace rows `which` (ascending, unique) of `table` by `rows`, keeping
+/// every other row: the new table is written into `spare` (its allocations
+/// reused) and swapped with `table`, so `spare` then holds the table as it
+/// was.
+pub fn splice_rows(table: &mut ShapeTable, spare: &mut ShapeTable, which: &[usize], rows: Vec<Row>) {
+    debug_assert_eq!(which.len(), rows.len());
     // Sized up front: growing the columns entry by entry reallocated and
     // copied the whole table a few times per split.
     let nnz = table.nnz() - which.iter().map(|&r| table.range(r).len()).sum::<usize>()
-        + built.iter().map(|(row, _)| row.len()).sum::<usize>();
+        + rows.iter().map(|row| row.len()).sum::<usize>();
     let out = spare;
     out.offsets.clear();
     out.index.clear();
@@ -345,7 +355,7 @@ pub fn rebuild_rows(
     out.value.reserve(nnz);
     out.grad.reserve(nnz);
     out.offsets.push(0);
-    let mut next = which.iter().zip(built.into_iter().map(|(row, _)| row)).peekable();
+    let mut next = which.iter().zip(rows).peekable();
     for r in 0..table.rows() {
         match next.peek() {
             Some((&w, _)) if w == r => {
@@ -366,7 +376,6 @@ pub fn rebuild_rows(
         out.offsets.push(out.index.len());
     }
     std::mem::swap(table, out);
-    Ok(reduced)
 }
 
 fn assemble(rows: Vec<Row>) -> ShapeTable {
