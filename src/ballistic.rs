@@ -339,8 +339,18 @@ impl EdgePhase {
     /// and "+0.00" for one that rounds to zero whatever its sign (a column
     /// on the edge up to round-off).
     pub fn offset_text(&self) -> String {
-        let offset = if self.offset.abs() < 0.005 { 0.0 } else { self.offset };
-        format!("{offset:+.2}")
+        format!("{:+.2}", self.offset_rounding_to(2))
+    }
+
+    /// The offset, or 0 where it rounds to zero at `decimals` decimals (so
+    /// that round-off never prints as "−0.00"): for the reports' text and
+    /// `convergence.csv`.
+    pub fn offset_rounding_to(&self, decimals: i32) -> Real {
+        if self.offset.abs() < 0.5 * (10.0 as Real).powi(-decimals) {
+            0.0
+        } else {
+            self.offset
+        }
     }
 }
 
@@ -1315,7 +1325,7 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
             st.shots.len(),
             r.edge.map_or("—".into(), |e| e.offset_text())
         ));
-        let edge = r.edge.map_or(String::new(), |e| format!("{:.4}", e.offset));
+        let edge = r.edge.map_or(String::new(), |e| format!("{:.4}", e.offset_rounding_to(4)));
         csv.push_str(&format!(",{},{wall:.2},{edge}\n", st.shots.len()));
     }
     let pct = |s: Option<Real>| s.map_or("—".into(), |x| format!("{:.1} %", 100.0 * x));
@@ -1764,6 +1774,12 @@ mod tests {
             assert!(e.describe().contains(" lies +0.00 of a spacing"), "{}", e.describe());
         }
         assert!(EdgePhase { edge: 0.01, column: 0.01, offset: -0.006 }.describe().contains(" lies -0.01 of"));
+        // convergence.csv's four decimals likewise
+        let csv = |offset: Real| format!("{:.4}", EdgePhase { edge: 0.01, column: 0.01, offset }.offset_rounding_to(4));
+        assert_eq!(
+            (csv(-1e-15), csv(-0.00004), csv(-0.00006), csv(-0.392)),
+            ("0.0000".into(), "0.0000".into(), "-0.0001".into(), "-0.3920".into())
+        );
     }
 
     #[test]

@@ -266,10 +266,17 @@ fn dispatch(cmd: Command) -> Result<()> {
                 info: RunInfo::current(&file, &set),
                 interrupt: install_interrupt_handler(),
             };
-            if let Some(rim) = rim_phase(&case) {
-                eprintln!("plugsim: {rim}");
-            }
-            drive(&cfg, |cfg, report| execute(&case, cfg, report))
+            // Stated once the run starts (after its output directory is
+            // accepted), before the run's own header.
+            let rim = rim_phase(&case);
+            drive(&cfg, |cfg, report| {
+                execute(&case, cfg, &mut |p| {
+                    if let (Progress::Started { .. }, Some(rim)) = (&p, &rim) {
+                        eprintln!("plugsim: {rim}");
+                    }
+                    report(p)
+                })
+            })
         }
         Command::Resume { dir } => {
             let cfg = RunConfig {

@@ -557,7 +557,8 @@ fn the_steps_floors_on_a_cracking_run_keep_its_residual() {
 /// against the plate's particle columns, as every ballistic study does. The
 /// small plate's lattice is uniform, 0.5 mm from x = −12 mm: an 8.6 mm wide
 /// projectile's edge, x = 4.3 mm, lies nearest the column at 4.5 mm, −0.4
-/// of a spacing from it (by hand); a case with no projectile says nothing.
+/// of a spacing from it (by hand); a case with no projectile says nothing,
+/// and `run` says it only once its output directory is accepted.
 #[test]
 fn check_and_run_state_the_projectile_s_edge_against_the_columns() {
     let dir = fresh_dir("rim");
@@ -584,6 +585,13 @@ fn check_and_run_state_the_projectile_s_edge_against_the_columns() {
     ]);
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success() && stderr.contains(&format!("plugsim: {line}")), "{stderr}");
+    let header = stderr.find("particles,").expect("the run's header");
+    assert!(stderr.find(line).unwrap() < header, "the rim line comes before the run's header: {stderr}");
+    // A run refused (its output directory exists, no --force) states nothing of it.
+    let args = ["--threads", "1", "run", case.to_str().unwrap(), "--set", width, "--out", out.to_str().unwrap()];
+    let o = common::plugsim(&args);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && !stderr.contains("projectile's edge"), "{stderr}");
     // On a column: +0.00 (the shared case's 8 mm projectile, edge at 4 mm).
     let o = common::plugsim(&["check", case.to_str().unwrap()]);
     let stdout = String::from_utf8_lossy(&o.stdout);
