@@ -1325,11 +1325,13 @@ fn a_tip_that_reaches_another_crack_joins_it() {
 /// deformation gradient (the shape part plus the carried jump) is
 /// unchanged, so no stress jumps; its own particle row is itself alone
 /// (its displacement is its own). Stepped on, it flies at its velocity.
+/// At 0.5 a whole fragment leaves: the points whose particles are all
+/// detached are eroded and their rows emptied, instead of a singular row.
 /// With `detach_below = 0` nothing is detached.
 #[test]
 fn isolated_particles_are_detached_and_fly_free() {
     let centre = Vec2::new(5.0 * H, 5.0 * H);
-    let setup = |detach_below: Real| {
+    let setup = |detach_below: Real, eroded_radius: Real| {
         let mut m = plate(11, 11);
         for i in 0..m.particles.len() {
             let x = m.particles.x0[i] - centre;
@@ -1337,14 +1339,14 @@ fn isolated_particles_are_detached_and_fly_free() {
             m.particles.v[i] = Vec2::new(3.0 + 1e3 * x.y, -2.0 + 5e2 * x.x);
         }
         for q in 0..m.quad.len() {
-            if (m.quad.x0[q] - centre).norm() < 2.2 * H {
+            if (m.quad.x0[q] - centre).norm() < eroded_radius {
                 m.quad.eroded[q] = true;
             }
         }
         let cracks = CrackGrowth::new(FractureParameters { detach_below, ..params(Criterion::Damage) });
         (m, cracks)
     };
-    let (mut m, mut cracks) = setup(0.1);
+    let (mut m, mut cracks) = setup(0.1, 2.2 * H);
     // The share by hand, from the rows.
     let n = m.particles.len();
     let (mut live, mut all) = (vec![0.0; n], vec![0.0; n]);
@@ -1402,8 +1404,22 @@ fn isolated_particles_are_detached_and_fly_free() {
         assert_eq!(sim.model.particles.f_int[i], Vec2::zeros());
         assert!((sim.model.particles.v[i] - v).norm() < 1e-12 * v.norm(), "particle {i}");
     }
+    // A fragment: a wider eroded disk at 0.5; where a point's particles
+    // are all detached, the point belongs to no body and is eroded, its
+    // row empty; every other row keeps a particle.
+    let (mut m, mut cracks) = setup(0.5, 3.2 * H);
+    let eroded_before = m.quad.eroded.iter().filter(|&&e| e).count();
+    let detached = cracks.detach_isolated(&mut m, 0.0).unwrap();
+    let orphans: Vec<usize> = (0..m.quad.len()).filter(|&q| m.qp_shape.range(q).is_empty()).collect();
+    let eroded_after = m.quad.eroded.iter().filter(|&&e| e).count();
+    eprintln!("at 0.5: detached {}, {} points left without particles", detached.len(), orphans.len());
+    assert!(!orphans.is_empty() && orphans.iter().all(|&q| m.quad.eroded[q]), "{orphans:?}");
+    assert!(eroded_after >= eroded_before && eroded_after - eroded_before <= orphans.len());
+    let total = m.particles.total_mass();
+    let mass0: Real = plate(11, 11).particles.mass.iter().sum();
+    assert!((total - mass0).abs() < 1e-12 * mass0);
     // Off: nothing detached.
-    let (mut m, mut cracks) = setup(0.0);
+    let (mut m, mut cracks) = setup(0.0, 2.2 * H);
     assert!(cracks.detach_isolated(&mut m, 0.0).unwrap().is_empty());
     assert!(m.particles.flags.iter().all(|f| !f.has(ParticleFlags::DETACHED)));
 }

@@ -17,7 +17,7 @@ use crate::model::{Gather, Model};
 use crate::neighbors::CellGrid;
 use crate::particles::{FaceSide, ParticleFlags};
 use crate::shape::ShapeTable;
-use crate::shape::{rebuild_rows, splice_rows, Basis, Row};
+use crate::shape::{build_rows, rebuild_rows, splice_rows, Basis, Row};
 use nalgebra::Matrix2;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -1259,8 +1259,9 @@ impl CrackGrowth {
     /// below `detach_below` is flagged [`ParticleFlags::DETACHED`] and the
     /// rows around it are rebuilt without it (`Self::rebuild_local`: the
     /// deformation gradients carried over, the masses re-lumped with its
-    /// own kept, the momentum restored). The particles detached at `time`
-    /// (s), in index order.
+    /// own kept, the momentum restored). A point whose particles are then
+    /// all detached is eroded, and the rebuild empties its row. The
+    /// particles detached at `time` (s), in index order.
     pub fn detach_isolated(&mut self, model: &mut Model, time: Real) -> Result<Vec<usize>, FractureError> {
         let threshold = self.params.detach_below;
         let eroded = &model.quad.eroded;
@@ -1283,6 +1284,21 @@ impl CrackGrowth {
         // and one detached later must keep the mass it has now.
         for &i in &isolated {
             model.particles.flags[i].set(ParticleFlags::DETACHED);
+        }
+        // A point whose particles are all detached is the fragment's own
+        // material and no body's any more: eroded (its row is emptied by
+        // the rebuild).
+        for &i in &isolated {
+            for j in model.gather.range(i) {
+                let q = model.gather.point[j] as usize;
+                let t = &model.qp_shape;
+                if !model.quad.eroded[q]
+                    && t.range(q).all(|k| model.particles.flags[t.index[k] as usize].has(ParticleFlags::DETACHED))
+                {
+                    model.quad.erode(q);
+                    self.eroded_seen[q] = true;
+                }
+            }
         }
         for &i in &isolated {
             let momentum = model.particles.momentum();
@@ -1350,7 +1366,34 @@ impl CrackGrowth {
         let mut particle_shape = std::mem::take(&mut model.particle_shape);
         let spare = &mut self.spare;
         let (qx, px) = (&model.quad.x0, &p.x0);
-        let r1 = rebuild_rows(&mut qp_shape, &mut spare.qp_shape, &rows_q, qx, px, &p.support, &p.volume, &vis);
+        // An eroded point whose particles are all detached belongs to no
+        // body any more (`detach_isolated`): its row is empty.
+        let detached_only = |q: usize| {
+            model.quad.eroded[q]
+                && qp_shape.range(q).all(|k| p.flags[qp_shape.index[k] as usize].has(ParticleFlags::DETACHED))
+        };
+        let (emptied, built_q): (Vec<usize>, Vec<usize>) = rows_q.iter().partition(|&&q| detached_only(q));
+        let r1 = build_rows(&built_q, qx, px, &p.support, &p.volume, &vis).map(|built| {
+            let mut built = built.into_iter();
+            let mut reduced = Vec::new();
+            let mut rows = Vec::with_capacity(rows_q.len());
+            for &q in &rows_q {
+                if emptied.binary_search(&q).is_ok() {
+                    rows.push(Row::new());
+                    continue;
+                }
+                let (row, basis) = built.next().expect("one built row per point not emptied");
+                if basis != Basis::Bilinear {
+                    reduced.push((q, basis));
+                }
+                rows.push(row);
+            }
+            (rows, reduced)
+        });
+        let r1 = r1.map(|(rows, reduced)| {
+            splice_rows(&mut qp_shape, &mut spare.qp_shape, &rows_q, rows);
+            reduced
+        });
         let r2 =
             rebuild_rows(&mut particle_shape, &mut spare.particle_shape, &rows_p, px, px, &p.support, &p.volume, &vis);
         // A detached particle moves by its own displacement alone: its

@@ -249,7 +249,9 @@
 //!   displacement), the deformation gradients are carried across the
 //!   change as at a split, the others' masses are re-lumped while it
 //!   keeps its own, and the momentum is restored. It stays a contact
-//!   slave and flies free. Test:
+//!   slave and flies free. A point whose particles are all detached is
+//!   the fragment's own material: it is eroded and its row emptied (a row
+//!   with no particle is singular). Test:
 //!   `isolated_particles_are_detached_and_fly_free` (tests/fracture.rs).
 //! - **The default model: Johnson–Cook damage over a material length
 //!   (issue #19; `criterion = "nonlocal_damage"`, the default; \[RL10\]'s

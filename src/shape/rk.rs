@@ -323,16 +323,29 @@ pub fn rebuild_rows(
     volume: &[Real],
     vis: &dyn Visibility,
 ) -> Result<Vec<(usize, Basis)>, ShapeError> {
-    let search = SupportSearch::new(x0, support);
-    // Rows are independent: built in parallel, collected in `which` order.
-    let built: Vec<(Row, Basis)> = which
-        .par_iter()
-        .map_init(Vec::new, |cand, &r| row_with_fallback(r, &points[r], &search, x0, support, volume, vis, cand))
-        .collect::<Result<_, _>>()?;
+    let built = build_rows(which, points, x0, support, volume, vis)?;
     let reduced: Vec<(usize, Basis)> =
         which.iter().zip(&built).filter(|(_, (_, b))| *b != Basis::Bilinear).map(|(&r, &(_, b))| (r, b)).collect();
     splice_rows(table, spare, which, built.into_iter().map(|(row, _)| row).collect());
     Ok(reduced)
+}
+
+/// The rows `which` at `points`, each with the richest regular basis
+/// ([`row_with_fallback`]) and that basis, in `which` order (built in
+/// parallel; the same bits for any thread count).
+pub fn build_rows(
+    which: &[usize],
+    points: &[Vec2],
+    x0: &[Vec2],
+    support: &[Real],
+    volume: &[Real],
+    vis: &dyn Visibility,
+) -> Result<Vec<(Row, Basis)>, ShapeError> {
+    let search = SupportSearch::new(x0, support);
+    which
+        .par_iter()
+        .map_init(Vec::new, |cand, &r| row_with_fallback(r, &points[r], &search, x0, support, volume, vis, cand))
+        .collect()
 }
 
 /// Replace rows `which` (ascending, unique) of `table` by `rows`, keeping
