@@ -266,7 +266,7 @@ pub fn gather_update(case: &Case, threads: usize, n: usize) -> Result<Vec<Figure
         let rows: Vec<usize> = (0..m.quad.len()).filter(|&q| (m.quad.x0[q] - centre).amax() <= reach).collect();
         let mut table = m.qp_shape.clone();
         let mut before = ShapeTable::default();
-        rebuild_rows(&mut table, &mut before, &rows, &m.quad.x0, &p.x0, &p.support, &p.volume, &AllVisible)
+        rebuild_rows(&mut table, &mut before, &rows, &m.quad.x0, &p.x0, &p.support, &p.volume, &AllVisible, &|_| None)
             .map_err(|source| crate::model::ModelError::Shape { body: "bench".into(), source })?;
         let touched = Gather::touched(&before, &table, &rows, np);
         let mut out = Gather::default();

@@ -412,11 +412,15 @@ impl Simulation {
         let (increment, ()) = rayon::join(|| work.iter().sum::<Real>(), || internal_force(&mut self.model));
         self.energies.internal += increment;
         let t3 = Instant::now();
+        // The full-step kinetic terms of the state the crack stage starts
+        // from; after a change it forms them again (and books the
+        // difference, `Energies::crack_changes`).
+        self.full_step_kinetic_terms();
+        let t3k = Instant::now();
         let cracked = self.grow_cracks(dt)?;
         let t3c = Instant::now();
         self.time += dt;
         self.step += 1;
-        self.full_step_kinetic_terms();
         // The checks run beside the kinetic energy's serial sum.
         let terms = &self.kinetic_scratch;
         let (health, kinetic) = rayon::join(|| self.diagnose(), || terms.iter().sum::<Real>());
@@ -432,14 +436,16 @@ impl Simulation {
         self.timers.material += th - t1;
         self.timers.heat += t2 - th;
         self.timers.internal_force += t3 - t2;
-        self.timers.crack_growth += t3c - t3;
-        self.timers.diagnostics += t4 - t3c;
+        self.timers.crack_growth += t3c - t3k;
+        self.timers.diagnostics += (t4 - t3c) + (t3k - t3);
         Ok(())
     }
 
     /// Crack growth at `t + Δt`; after a change the new crack-face
-    /// particles join the contact slaves and the internal force is
-    /// recomputed with the patched table. Whether the cracks changed.
+    /// particles join the contact slaves, the internal force is
+    /// recomputed with the patched table, and the full-step kinetic terms
+    /// (formed by the caller before the stage) are formed again, the
+    /// change of their sum booked. Whether the cracks changed.
     fn grow_cracks(&mut self, dt: Real) -> Result<bool, SolverError> {
         let Some(cracks) = self.cracks.as_mut() else {
             return Ok(false);
@@ -448,10 +454,6 @@ impl Simulation {
         if cracks.params.critical_value().is_none() {
             return Ok(false);
         }
-        // The full-step kinetic energy before any change, to book what the
-        // changes move (`Energies::crack_changes`).
-        let before = self.full_step_kinetic();
-        let cracks = self.cracks.as_mut().expect("checked above");
         let fracture_error = |source| SolverError::Fracture { source: Box::new(source), step, time };
         let faces = cracks.grow(&mut self.model, time, step).map_err(fracture_error)?;
         // Particles that erosion (this step's, or the grown cracks') left
@@ -460,11 +462,14 @@ impl Simulation {
         if faces.is_empty() && detached.is_empty() {
             return Ok(false);
         }
+        // The terms still hold the state before the changes.
+        let before: Real = self.kinetic_scratch.iter().sum();
         if !faces.is_empty() {
             self.crack_faces_changed(&faces);
         }
         internal_force(&mut self.model);
-        self.energies.crack_changes += before - self.full_step_kinetic();
+        self.full_step_kinetic_terms();
+        self.energies.crack_changes += before - self.kinetic_scratch.iter().sum::<Real>();
         Ok(true)
     }
 
@@ -601,13 +606,6 @@ impl Simulation {
                 constrain(*flags, &mut acc);
                 *e = 0.5 * m * (v + acc * half).norm_squared();
             });
-    }
-
-    /// The full-step kinetic energy of the particles as they are now
-    /// ([`Simulation::full_step_kinetic_terms`], summed in index order).
-    fn full_step_kinetic(&mut self) -> Real {
-        self.full_step_kinetic_terms();
-        self.kinetic_scratch.iter().sum()
     }
 
     /// Deformation and velocity gradients, material update, `P w`.

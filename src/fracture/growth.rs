@@ -17,7 +17,7 @@ use crate::model::{Gather, Model};
 use crate::neighbors::CellGrid;
 use crate::particles::{FaceSide, ParticleFlags};
 use crate::shape::ShapeTable;
-use crate::shape::{build_rows, rebuild_rows, splice_rows, Basis, Row};
+use crate::shape::{rebuild_rows, Basis, Row};
 use nalgebra::Matrix2;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -1264,9 +1264,12 @@ impl CrackGrowth {
     /// particles detached at `time` (s), in index order.
     pub fn detach_isolated(&mut self, model: &mut Model, time: Real) -> Result<Vec<usize>, FractureError> {
         let threshold = self.params.detach_below;
+        if threshold <= 0.0 {
+            return Ok(Vec::new());
+        }
         let eroded = &model.quad.eroded;
         self.eroded_seen.resize(eroded.len(), false);
-        if threshold <= 0.0 || eroded.iter().zip(&self.eroded_seen).all(|(e, s)| e == s) {
+        if eroded.iter().zip(&self.eroded_seen).all(|(e, s)| e == s) {
             return Ok(Vec::new());
         }
         let mut near = std::collections::BTreeSet::new();
@@ -1353,9 +1356,8 @@ impl CrackGrowth {
             let end = *ps.offsets.last().expect("offsets start at 0");
             ps.offsets.push(end);
         }
-        let (rows_p, detached): (Vec<usize>, Vec<usize>) = (0..n)
-            .filter(|&i| model.particles.body[i] == body && inside(&model.particles.x0[i]))
-            .partition(|&i| !model.particles.flags[i].has(ParticleFlags::DETACHED));
+        let rows_p: Vec<usize> =
+            (0..n).filter(|&i| model.particles.body[i] == body && inside(&model.particles.x0[i])).collect();
         // The RK deformation gradients before the change (module doc:
         // "deformation gradient across a crack change").
         let f_before: Vec<Tensor3> = rows_q.iter().map(|&q| model.shape_deformation_gradient(q)).collect();
@@ -1372,35 +1374,24 @@ impl CrackGrowth {
             model.quad.eroded[q]
                 && qp_shape.range(q).all(|k| p.flags[qp_shape.index[k] as usize].has(ParticleFlags::DETACHED))
         };
-        let (emptied, built_q): (Vec<usize>, Vec<usize>) = rows_q.iter().partition(|&&q| detached_only(q));
-        let r1 = build_rows(&built_q, qx, px, &p.support, &p.volume, &vis).map(|built| {
-            let mut built = built.into_iter();
-            let mut reduced = Vec::new();
-            let mut rows = Vec::with_capacity(rows_q.len());
-            for &q in &rows_q {
-                if emptied.binary_search(&q).is_ok() {
-                    rows.push(Row::new());
-                    continue;
-                }
-                let (row, basis) = built.next().expect("one built row per point not emptied");
-                if basis != Basis::Bilinear {
-                    reduced.push((q, basis));
-                }
-                rows.push(row);
-            }
-            (rows, reduced)
-        });
-        let r1 = r1.map(|(rows, reduced)| {
-            splice_rows(&mut qp_shape, &mut spare.qp_shape, &rows_q, rows);
-            reduced
-        });
-        let r2 =
-            rebuild_rows(&mut particle_shape, &mut spare.particle_shape, &rows_p, px, px, &p.support, &p.volume, &vis);
+        let emptied: Vec<usize> = rows_q.iter().copied().filter(|&q| detached_only(q)).collect();
+        let empty = |q: usize| emptied.binary_search(&q).is_ok().then(Row::new);
+        let r1 = rebuild_rows(&mut qp_shape, &mut spare.qp_shape, &rows_q, qx, px, &p.support, &p.volume, &vis, &empty);
         // A detached particle moves by its own displacement alone: its
         // row is itself, `N = 1`, `∇N = 0` (the rows of the others no
         // longer see it).
-        let own: Vec<Row> = detached.iter().map(|&i| vec![(i as u32, 1.0, Vec2::zeros())]).collect();
-        splice_rows(&mut particle_shape, &mut spare.particle_shape, &detached, own);
+        let own = |i: usize| p.flags[i].has(ParticleFlags::DETACHED).then(|| vec![(i as u32, 1.0, Vec2::zeros())]);
+        let r2 = rebuild_rows(
+            &mut particle_shape,
+            &mut spare.particle_shape,
+            &rows_p,
+            px,
+            px,
+            &p.support,
+            &p.volume,
+            &vis,
+            &own,
+        );
         model.qp_shape = qp_shape;
         model.particle_shape = particle_shape;
         for (rows, reduced, map) in
@@ -1410,9 +1401,6 @@ impl CrackGrowth {
                 map.remove(r);
             }
             map.extend(reduced);
-        }
-        for r in &detached {
-            self.reduced_particle_rows.remove(r);
         }
         for (&q, before) in rows_q.iter().zip(&f_before) {
             let after = model.shape_deformation_gradient(q);

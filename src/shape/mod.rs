@@ -4,7 +4,6 @@ pub mod rk;
 pub mod table;
 
 pub use rk::{
-    build_rows, build_table, rebuild_rows, row_with_basis, row_with_fallback, splice_rows, AllVisible, Basis, Row,
-    ShapeError, Visibility,
+    build_table, rebuild_rows, row_with_basis, row_with_fallback, AllVisible, Basis, Row, ShapeError, Visibility,
 };
 pub use table::ShapeTable;

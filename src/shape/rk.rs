@@ -306,12 +306,14 @@ pub fn build_table(
 
 /// Recompute rows `which` (ascending, unique) of `table` at `points` after a
 /// local visibility change, each with the richest regular basis
-/// ([`row_with_fallback`]), keeping every other row; returns the rows that
-/// needed a reduced basis, with that basis. The new table is written into
-/// `spare` (its allocations reused) and swapped with `table`: `spare` then
-/// holds the table as it was. On an error `table` is unchanged. A rebuilt
-/// row whose visibility did not change equals the row [`build_table`] made,
-/// bit for bit (same builder).
+/// ([`row_with_fallback`]), keeping every other row; a row for which
+/// `given` returns one takes that row instead (a detached particle's own,
+/// an orphaned point's empty one: `crate::fracture::CrackGrowth::detach_isolated`).
+/// Returns the built rows that needed a reduced basis, with that basis.
+/// The new table is written into `spare` (its allocations reused) and
+/// swapped with `table`: `spare` then holds the table as it was. On an
+/// error `table` is unchanged. A rebuilt row whose visibility did not
+/// change equals the row [`build_table`] made, bit for bit (same builder).
 #[allow(clippy::too_many_arguments)]
 pub fn rebuild_rows(
     table: &mut ShapeTable,
@@ -322,37 +324,33 @@ pub fn rebuild_rows(
     support: &[Real],
     volume: &[Real],
     vis: &dyn Visibility,
+    given: &(dyn Fn(usize) -> Option<Row> + Sync),
 ) -> Result<Vec<(usize, Basis)>, ShapeError> {
-    let built = build_rows(which, points, x0, support, volume, vis)?;
-    let reduced: Vec<(usize, Basis)> =
-        which.iter().zip(&built).filter(|(_, (_, b))| *b != Basis::Bilinear).map(|(&r, &(_, b))| (r, b)).collect();
+    let search = SupportSearch::new(x0, support);
+    // Rows are independent: built in parallel, collected in `which` order.
+    let built: Vec<(Row, Option<Basis>)> = which
+        .par_iter()
+        .map_init(Vec::new, |cand, &r| match given(r) {
+            Some(row) => Ok((row, None)),
+            None => {
+                row_with_fallback(r, &points[r], &search, x0, support, volume, vis, cand).map(|(row, b)| (row, Some(b)))
+            }
+        })
+        .collect::<Result<_, _>>()?;
+    let reduced: Vec<(usize, Basis)> = which
+        .iter()
+        .zip(&built)
+        .filter_map(|(&r, &(_, b))| b.filter(|&b| b != Basis::Bilinear).map(|b| (r, b)))
+        .collect();
     splice_rows(table, spare, which, built.into_iter().map(|(row, _)| row).collect());
     Ok(reduced)
-}
-
-/// The rows `which` at `points`, each with the richest regular basis
-/// ([`row_with_fallback`]) and that basis, in `which` order (built in
-/// parallel; the same bits for any thread count).
-pub fn build_rows(
-    which: &[usize],
-    points: &[Vec2],
-    x0: &[Vec2],
-    support: &[Real],
-    volume: &[Real],
-    vis: &dyn Visibility,
-) -> Result<Vec<(Row, Basis)>, ShapeError> {
-    let search = SupportSearch::new(x0, support);
-    which
-        .par_iter()
-        .map_init(Vec::new, |cand, &r| row_with_fallback(r, &points[r], &search, x0, support, volume, vis, cand))
-        .collect()
 }
 
 /// Replace rows `which` (ascending, unique) of `table` by `rows`, keeping
 /// every other row: the new table is written into `spare` (its allocations
 /// reused) and swapped with `table`, so `spare` then holds the table as it
 /// was.
-pub fn splice_rows(table: &mut ShapeTable, spare: &mut ShapeTable, which: &[usize], rows: Vec<Row>) {
+fn splice_rows(table: &mut ShapeTable, spare: &mut ShapeTable, which: &[usize], rows: Vec<Row>) {
     debug_assert_eq!(which.len(), rows.len());
     // Sized up front: growing the columns entry by entry reallocated and
     // copied the whole table a few times per split.
@@ -434,7 +432,8 @@ mod tests {
         let reference = build_table(&pts, &x0, &a, &v, &AllVisible).unwrap();
         let mut t = reference.clone();
         let reduced =
-            rebuild_rows(&mut t, &mut ShapeTable::default(), &[0, 1], &pts, &x0, &a, &v, &AllVisible).unwrap();
+            rebuild_rows(&mut t, &mut ShapeTable::default(), &[0, 1], &pts, &x0, &a, &v, &AllVisible, &|_| None)
+                .unwrap();
         assert!(reduced.is_empty());
         assert_eq!(t, reference);
         let search = SupportSearch::new(&x0, &a);
