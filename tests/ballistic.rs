@@ -199,13 +199,8 @@ fn the_command_runs_the_study_at_each_resolution() {
     let dir = fresh_dir("rows");
     let case = dir.join("small.toml");
     std::fs::write(&case, small_plate()).unwrap();
-    let plugsim = |args: &[&str]| {
-        std::process::Command::new(env!("CARGO_BIN_EXE_plugsim"))
-            .args(["--threads", "1", "ballistic", case.to_str().unwrap()])
-            .args(args)
-            .output()
-            .unwrap()
-    };
+    let plugsim =
+        |args: &[&str]| common::plugsim(&[&["--threads", "1", "ballistic", case.to_str().unwrap()], args].concat());
     let out = dir.join("out");
     // Given out of order and twice: run coarsest first, each once.
     let o = plugsim(&["--rows", "9,5,9", "--speeds", "500", "--out", out.to_str().unwrap()]);
@@ -228,7 +223,7 @@ fn the_command_runs_the_study_at_each_resolution() {
     assert!(!o.status.success() && stderr.contains("at least 2"), "{stderr}");
     assert!(!bad.exists(), "refused before any run");
     // The option's help states the default the library uses.
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_plugsim")).args(["ballistic", "--help"]).output().unwrap();
+    let o = common::plugsim(&["ballistic", "--help"]);
     let help = String::from_utf8_lossy(&o.stdout);
     let default = format!("default: {} times the case's end time", plugsim::ballistic::DECIDE_FACTOR);
     assert!(help.contains(&default), "{help}");
@@ -432,12 +427,9 @@ fn a_study_writes_sparse_snapshots_unless_told() {
     // The snapshot times of the run at 500 m/s in `out`, µs.
     let times = |name: &str, args: &[&str]| -> Vec<f64> {
         let out = dir.join(name);
-        let o = std::process::Command::new(env!("CARGO_BIN_EXE_plugsim"))
-            .args(["--threads", "1", "ballistic", case.to_str().unwrap(), "--speeds", "500"])
-            .args(["--out", out.to_str().unwrap()])
-            .args(args)
-            .output()
-            .unwrap();
+        let head =
+            ["--threads", "1", "ballistic", case.to_str().unwrap(), "--speeds", "500", "--out", out.to_str().unwrap()];
+        let o = common::plugsim(&[&head[..], args].concat());
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         let md = std::fs::read_to_string(out.join("ballistic.md")).unwrap();
         let pvd = std::fs::read_to_string(out.join("v500.00/results.pvd")).unwrap();
@@ -468,11 +460,9 @@ fn a_study_writes_sparse_snapshots_unless_told() {
         assert_eq!(t.last(), default.last(), "the last state is written whatever the interval");
     }
     // A negative interval is refused, naming the option, before any run.
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_plugsim"))
-        .args(["ballistic", case.to_str().unwrap(), "--speeds", "500", "--snapshot-every=-1"])
-        .args(["--out", dir.join("bad").to_str().unwrap()])
-        .output()
-        .unwrap();
+    let bad = dir.join("bad");
+    let (case, bad) = (case.to_str().unwrap(), bad.to_str().unwrap());
+    let o = common::plugsim(&["ballistic", case, "--speeds", "500", "--snapshot-every=-1", "--out", bad]);
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && stderr.contains("--snapshot-every"), "{stderr}");
     assert!(!dir.join("bad").exists());
