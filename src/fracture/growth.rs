@@ -1269,9 +1269,7 @@ impl CrackGrowth {
         }
         let eroded = &model.quad.eroded;
         self.eroded_seen.resize(eroded.len(), false);
-        if eroded.iter().zip(&self.eroded_seen).all(|(e, s)| e == s) {
-            return Ok(Vec::new());
-        }
+        // The particles in the rows of the points eroded since the last call.
         let mut near = std::collections::BTreeSet::new();
         for (q, (&e, seen)) in eroded.iter().zip(self.eroded_seen.iter_mut()).enumerate() {
             if e && !*seen {
@@ -1294,10 +1292,7 @@ impl CrackGrowth {
         for &i in &isolated {
             for j in model.gather.range(i) {
                 let q = model.gather.point[j] as usize;
-                let t = &model.qp_shape;
-                if !model.quad.eroded[q]
-                    && t.range(q).all(|k| model.particles.flags[t.index[k] as usize].has(ParticleFlags::DETACHED))
-                {
+                if !model.quad.eroded[q] && only_detached(&model.qp_shape, &model.particles.flags, q) {
                     model.quad.erode(q);
                     self.eroded_seen[q] = true;
                 }
@@ -1370,11 +1365,8 @@ impl CrackGrowth {
         let (qx, px) = (&model.quad.x0, &p.x0);
         // An eroded point whose particles are all detached belongs to no
         // body any more (`detach_isolated`): its row is empty.
-        let detached_only = |q: usize| {
-            model.quad.eroded[q]
-                && qp_shape.range(q).all(|k| p.flags[qp_shape.index[k] as usize].has(ParticleFlags::DETACHED))
-        };
-        let emptied: Vec<usize> = rows_q.iter().copied().filter(|&q| detached_only(q)).collect();
+        let emptied: Vec<usize> =
+            rows_q.iter().copied().filter(|&q| model.quad.eroded[q] && only_detached(&qp_shape, &p.flags, q)).collect();
         let empty = |q: usize| emptied.binary_search(&q).is_ok().then(Row::new);
         let r1 = rebuild_rows(&mut qp_shape, &mut spare.qp_shape, &rows_q, qx, px, &p.support, &p.volume, &vis, &empty);
         // A detached particle moves by its own displacement alone: its
@@ -1483,6 +1475,13 @@ impl crate::shape::Visibility for OwnBody<'_> {
             && !self.flags[particle].has(ParticleFlags::DETACHED)
             && self.cracks.visible(x, particle)
     }
+}
+
+/// Whether every particle in row `q` of `table` is detached
+/// ([`CrackGrowth::detach_isolated`]): the point is then a fragment's own
+/// material, no body's.
+fn only_detached(table: &ShapeTable, flags: &[ParticleFlags], q: usize) -> bool {
+    table.range(q).all(|k| flags[table.index[k] as usize].has(ParticleFlags::DETACHED))
 }
 
 /// The share of particle `i`'s material at quadrature points that are
