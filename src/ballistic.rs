@@ -354,6 +354,86 @@ impl EdgePhase {
     }
 }
 
+/// `plugsim ballistic --phases K`: `K` lattice phases at the rim, evenly
+/// over one spacing, `k/K` for `k = 0 … K−1` written in (−½, ½] (4: 0,
+/// +0.25, +0.5, −0.25). The first is a column on the projectile's edge.
+pub fn phases(count: usize) -> Vec<Real> {
+    (0..count)
+        .map(|k| {
+            let p = k as Real / count as Real;
+            if p > 0.5 {
+                p - 1.0
+            } else {
+                p
+            }
+        })
+        .collect()
+}
+
+/// `case` with its target's particle columns shifted so that the
+/// projectile's edge lies `phase` spacings (in [−½, ½]) from the nearest
+/// one ([`edge_phase`]). The fine zone's columns stand at `x_f + k h'`
+/// from `refine_at` (`x_f`); with the edge at distance `d` from it, `h' =
+/// d / (n + φ)`, `n` the nearest whole number to `d/h − φ` (at least 1,
+/// `h` the fine spacing the case resolves to, `φ` the phase signed toward
+/// `x_f`), puts the edge exactly `φ` spacings past column `n`. The fine
+/// spacing changes by at most half a spacing over `d` (2.3 % at 24 rows on
+/// the built-in plates); the rows through the thickness do not change. A
+/// `column_at` of the case moves to column `n`. The edge must lie in the
+/// uniform fine zone. Returns the case and the `--set` overrides that give
+/// it.
+///
+/// Why: near a limit the rim crack's first steps, and with them the limit,
+/// can depend on which fraction of a spacing the edge lies from a column
+/// (docs/validation.md, "Case II's plate on the 48 / 72 / 96 ladder"),
+/// and that fraction changes from one resolution to the next. A study over
+/// several phases at each resolution measures that dependence instead of
+/// sampling it once ([`ladder_table`]'s envelope).
+pub fn at_phase(case: &Case, projectile: Projectile, phase: Real) -> Result<(Case, Vec<String>), BallisticError> {
+    if !(phase.is_finite() && phase.abs() <= 0.5) {
+        return Err(BallisticError::Settings(format!("a lattice phase lies in [-0.5, 0.5] spacings, got {phase}")));
+    }
+    let no_edge = || {
+        BallisticError::Settings(
+            "--phases: the projectile's edge does not lie over the target's particle columns, so it has no phase"
+                .into(),
+        )
+    };
+    let b = target(case).ok_or_else(no_edge)?;
+    let edge = edge_phase(case, projectile).ok_or_else(no_edge)?.edge;
+    let resolved = case.resolved();
+    let grid = &resolved.bodies[b].rectangle;
+    let (x_f, h) = (grid.refine_at.ok_or_else(no_edge)?, grid.fine_spacing.ok_or_else(no_edge)?);
+    let (d, toward) = ((edge - x_f).abs(), if edge >= x_f { 1.0 } else { -1.0 });
+    let signed = toward * phase;
+    let n = (d / h - signed).round().max(1.0);
+    let fine = d / (n + signed);
+    let name = &case.bodies[b].name;
+    let mut c = case.clone();
+    let r = &mut c.bodies[b].rectangle;
+    r.fine_spacing = Some(fine);
+    let mut set = vec![format!("bodies.{name}.rectangle.fine_spacing={fine:e}")];
+    if r.column_at.is_some() {
+        let column = x_f + toward * n * fine;
+        r.column_at = Some(column);
+        set.push(format!("bodies.{name}.rectangle.column_at={column:e}"));
+    }
+    if let Some(p) = c.validate().into_iter().find(|p| p.key.starts_with(&format!("bodies[{b}].rectangle"))) {
+        return Err(BallisticError::Settings(format!("--phases {phase:+.2}: {}: {}", p.key, p.message)));
+    }
+    let got = edge_phase(&c, projectile).ok_or_else(no_edge)?.offset;
+    // ±½ are one phase (the edge midway between two columns)
+    if ((got - phase + 0.5).rem_euclid(1.0) - 0.5).abs() > 1e-6 {
+        return Err(BallisticError::Settings(format!(
+            "--phases {phase:+.2}: the edge (x = {:.4} mm) lies outside the target's uniform fine zone (within \
+             fine_half_width = {} m of refine_at = {x_f} m), whose columns the phase shifts",
+            edge * 1e3,
+            grid.fine_half_width
+        )));
+    }
+    Ok((c, set))
+}
+
 /// The deformable projectiles of `case` by index among its bodies.
 fn flying_bodies(case: &Case) -> Vec<usize> {
     case.deformable_flights().into_iter().map(|(_, b, _)| b).collect()
@@ -1250,7 +1330,95 @@ pub struct Rung {
     /// The projectile's edge against this resolution's columns
     /// ([`edge_phase`]).
     pub edge: Option<EdgePhase>,
+    /// The lattice phase asked for with `--phases` ([`at_phase`]); `None`
+    /// for the case's own columns.
+    pub phase: Option<Real>,
     pub study: Study,
+}
+
+impl Rung {
+    /// "24 rows", or "24 rows, phase +0.25" with `--phases`.
+    pub fn label(&self) -> String {
+        match self.phase {
+            Some(p) => format!("{} rows, phase {p:+.2}", self.rows),
+            None => format!("{} rows", self.rows),
+        }
+    }
+}
+
+/// How many resolutions and lattice phases `rungs` span: "3 resolutions",
+/// "1 resolution at 4 lattice phases".
+pub fn ladder_extent(rungs: &[Rung]) -> String {
+    let mut rows: Vec<usize> = rungs.iter().map(|r| r.rows).collect();
+    rows.sort_unstable();
+    rows.dedup();
+    let res = format!("{} resolution{}", rows.len(), if rows.len() == 1 { "" } else { "s" });
+    match rungs.iter().filter(|r| r.phase.is_some()).count() {
+        0 => res,
+        n => format!("{res} at {} lattice phases", n / rows.len().max(1)),
+    }
+}
+
+/// What a ladder compares at one resolution ([`levels`]): the limit and
+/// the residual at each speed as (value, half-width).
+#[derive(Clone, Debug, PartialEq)]
+struct Level {
+    rows: usize,
+    spacing: Real,
+    /// The rungs at this resolution (several with `--phases`).
+    members: usize,
+    /// The bracketed limit: a rung's own, or over the phases their
+    /// envelope (the lowest held bound to the highest perforating one).
+    limit: Option<(Real, Real)>,
+    /// The residual where every member perforated: a rung's own (half-width
+    /// 0), or over the phases their mean with half their range.
+    residuals: Vec<Option<(Real, Real)>>,
+}
+
+/// The rungs grouped by resolution, in the order given ([`Level`]).
+/// A resolution's limit counts only if every member's is bracketed, a
+/// residual only if every member perforated at that speed.
+fn levels(rungs: &[Rung], speeds: &[Real]) -> Vec<Level> {
+    let mut rows: Vec<usize> = Vec::new();
+    for r in rungs {
+        if !rows.contains(&r.rows) {
+            rows.push(r.rows);
+        }
+    }
+    let envelope = |pairs: Vec<(Real, Real)>| {
+        let lo = pairs.iter().map(|&(v, h)| v - h).fold(Real::INFINITY, Real::min);
+        let hi = pairs.iter().map(|&(v, h)| v + h).fold(Real::NEG_INFINITY, Real::max);
+        (0.5 * (lo + hi), 0.5 * (hi - lo))
+    };
+    rows.into_iter()
+        .map(|n| {
+            let members: Vec<&Rung> = rungs.iter().filter(|r| r.rows == n).collect();
+            let limits: Option<Vec<(Real, Real)>> =
+                members.iter().map(|r| r.study.limit_reading().and_then(|l| l.estimate())).collect();
+            let residuals = speeds
+                .iter()
+                .map(|&v| {
+                    let at: Option<Vec<Real>> = members
+                        .iter()
+                        .map(|r| {
+                            r.study.shots.iter().find(|s| s.speed == v).and_then(|s| s.residual()).filter(|&x| x > 0.0)
+                        })
+                        .collect();
+                    at.map(|x| {
+                        let mean = x.iter().sum::<Real>() / x.len() as Real;
+                        (mean, envelope(x.iter().map(|&y| (y, 0.0)).collect()).1)
+                    })
+                })
+                .collect();
+            Level {
+                rows: n,
+                spacing: members[0].spacing,
+                members: members.len(),
+                limit: limits.map(envelope),
+                residuals,
+            }
+        })
+        .collect()
 }
 
 /// The resolutions side by side, as (Markdown, CSV): per rung the ballistic
@@ -1265,7 +1433,12 @@ pub struct Rung {
 /// none); the limit's spread, step and extrapolation count only bracketed
 /// limits (with their brackets), a residual's only if every rung
 /// perforated at that speed (a held run is 0 m/s, which no spread
-/// describes: the Markdown says "held").
+/// describes: the Markdown says "held"). With several lattice phases at a
+/// resolution (`--phases`, [`at_phase`]) each rung is a line of its own
+/// and a line per resolution gives their envelope (the limit
+/// from the lowest held bound to the highest perforating one, a residual's
+/// mean ± half its range), which the spread, the step and Richardson then
+/// compare: the answer whatever the phase.
 pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
     let mut md = String::from("| rows | spacing (mm) | v_bl (m/s) | Recht–Ipson a, p, v_bl |");
     let mut csv = String::from("rows,spacing_mm,v_bl_m_s,v_bl_half_width_m_s,a,p,fit_v_bl_m_s");
@@ -1277,12 +1450,7 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
     md.push_str(&"---|".repeat(speeds.len() + 3));
     md.push('\n');
     csv.push_str(",runs,wall_s,edge_offset\n");
-    // Each rung's limit (value, half-width) if bracketed, its residual at a
-    // speed, and that residual where it perforated (the spread and the step
-    // compare those only).
-    let limit_of = |st: &Study| st.limit_reading().and_then(|l| l.estimate());
     let residual_at = |st: &Study, v: Real| st.shots.iter().find(|s| s.speed == v).and_then(|s| s.residual());
-    let perforated_at = |st: &Study, v: Real| residual_at(st, v).filter(|&x| x > 0.0);
     for r in rungs {
         let st = &r.study;
         let reading = st.limit_reading();
@@ -1328,54 +1496,73 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
         let edge = r.edge.map_or(String::new(), |e| format!("{:.4}", e.offset_rounding_to(4)));
         csv.push_str(&format!(",{},{wall:.2},{edge}\n", st.shots.len()));
     }
+    let levels = levels(rungs, speeds);
+    // With --phases: each resolution's envelope over its phases, the value
+    // that the spread, the step and Richardson compare.
+    for l in levels.iter().filter(|l| l.members > 1) {
+        let members: Vec<&Rung> = rungs.iter().filter(|r| r.rows == l.rows).collect();
+        md.push_str(&format!(
+            "| {} rows, {} phases | {:.3} | {} | |",
+            l.rows,
+            l.members,
+            l.spacing * 1e3,
+            l.limit.map_or("—".into(), |(v, h)| format!("{v:.2} ± {h:.2}"))
+        ));
+        for x in &l.residuals {
+            md.push_str(&x.map_or(" — |".into(), |(v, h)| format!(" {v:.2} ± {h:.2} |")));
+        }
+        let runs: usize = members.iter().map(|r| r.study.shots.len()).sum();
+        let wall: Real = members.iter().flat_map(|r| &r.study.shots).map(|s| s.wall).sum();
+        md.push_str(&format!(" {runs} | {wall:.0} | all |\n"));
+    }
     let pct = |s: Option<Real>| s.map_or("—".into(), |x| format!("{:.1} %", 100.0 * x));
-    let limits: Vec<Real> = rungs.iter().filter_map(|r| limit_of(&r.study).map(|e| e.0)).collect();
-    md.push_str(&format!(
-        "| spread | | {} | |",
-        if limits.len() == rungs.len() { pct(spread(&limits)) } else { "—".into() }
-    ));
-    for &v in speeds {
-        let vr: Option<Vec<Real>> = rungs.iter().map(|r| perforated_at(&r.study, v)).collect();
-        md.push_str(&format!(" {} |", pct(vr.and_then(|x| spread(&x)))));
+    let values = |f: &dyn Fn(&Level) -> Option<(Real, Real)>| -> Option<Vec<Real>> {
+        levels.iter().map(|l| f(l).map(|x| x.0)).collect()
+    };
+    md.push_str(&format!("| spread | | {} | |", pct(values(&|l| l.limit).and_then(|x| spread(&x)))));
+    for k in 0..speeds.len() {
+        md.push_str(&format!(" {} |", pct(values(&|l| l.residuals[k]).and_then(|x| spread(&x)))));
     }
     md.push_str(" | | |\n");
-    // The two finest rungs, by rows (the order given need not be).
-    let mut by_rows: Vec<&Rung> = rungs.iter().collect();
-    by_rows.sort_by_key(|r| r.rows);
+    // The two finest resolutions, by rows (the order given need not be).
+    let mut by_rows: Vec<&Level> = levels.iter().collect();
+    by_rows.sort_by_key(|l| l.rows);
+    let signed = |x: Real| format!("{:+.1} %", 100.0 * x);
+    let step_cell = |c: Option<(Real, Real)>, f: Option<(Real, Real)>| match (c, f) {
+        (Some(c), Some(f)) if c.1 == 0.0 && f.1 == 0.0 => signed(step(c, f).0),
+        (Some(c), Some(f)) => {
+            let (mid, least, most) = step(c, f);
+            format!("{} ({}…{})", signed(mid), signed(least), signed(most))
+        }
+        _ => "—".into(),
+    };
     if let [.., coarse, fine] = by_rows[..] {
-        let signed = |x: Real| format!("{:+.1} %", 100.0 * x);
-        md.push_str(&format!("| step {} → {} rows | | ", coarse.rows, fine.rows));
-        md.push_str(&match (limit_of(&coarse.study), limit_of(&fine.study)) {
-            (Some(c), Some(f)) => {
-                let (mid, least, most) = step(c, f);
-                format!("{} ({}…{})", signed(mid), signed(least), signed(most))
-            }
-            _ => "—".into(),
-        });
-        md.push_str(" | |");
-        for &v in speeds {
-            md.push_str(&match (perforated_at(&coarse.study, v), perforated_at(&fine.study, v)) {
-                (Some(c), Some(f)) => format!(" {} |", signed(step((c, 0.0), (f, 0.0)).0)),
-                _ => " — |".into(),
-            });
+        md.push_str(&format!(
+            "| step {} → {} rows | | {} | |",
+            coarse.rows,
+            fine.rows,
+            step_cell(coarse.limit, fine.limit)
+        ));
+        for k in 0..speeds.len() {
+            md.push_str(&format!(" {} |", step_cell(coarse.residuals[k], fine.residuals[k])));
         }
         md.push_str(" | | |\n");
     }
     if let [.., third, second, first] = by_rows[..] {
         let three = [third, second, first];
-        let ladder = |value: &dyn Fn(&Rung) -> Option<(Real, Real)>| -> Option<Vec<convergence::Rung>> {
+        let ladder = |value: &dyn Fn(&Level) -> Option<(Real, Real)>| -> Option<Vec<convergence::Rung>> {
             three
                 .iter()
-                .map(|r| {
-                    value(r).map(|(value, half_width)| convergence::Rung { spacing: r.spacing, value, half_width })
+                .map(|l| {
+                    value(l).map(|(value, half_width)| convergence::Rung { spacing: l.spacing, value, half_width })
                 })
                 .collect()
         };
         md.push_str(&format!("| Richardson, {} / {} / {} rows | | ", third.rows, second.rows, first.rows));
-        md.push_str(&convergence::describe(ladder(&|r| limit_of(&r.study)).and_then(|l| richardson(&l))));
+        md.push_str(&convergence::describe(ladder(&|l| l.limit).and_then(|l| richardson(&l))));
         md.push_str(" | |");
-        for &v in speeds {
-            let rungs = ladder(&|r| perforated_at(&r.study, v).map(|x| (x, 0.0)));
+        for k in 0..speeds.len() {
+            let rungs = ladder(&|l| l.residuals[k]);
             md.push_str(&format!(" {} |", convergence::describe(rungs.and_then(|l| richardson(&l)))));
         }
         md.push_str(" | | |\n");
@@ -1401,8 +1588,8 @@ pub fn ladder_plot(rungs: &[Rung], title: &str, experiments: &[(Real, Real)]) ->
             points.extend(s.points.iter().copied().chain([(Real::NAN, Real::NAN)]));
         }
         let name = match &r.study.fit {
-            Some(f) => format!("{} rows: Recht-Ipson a = {:.3}, p = {:.2}, v_bl = {:.1} m/s", r.rows, f.a, f.p, f.v_bl),
-            None => format!("{} rows", r.rows),
+            Some(f) => format!("{}: Recht-Ipson a = {:.3}, p = {:.2}, v_bl = {:.1} m/s", r.label(), f.a, f.p, f.v_bl),
+            None => r.label(),
         };
         p.series.push(Series { name, points });
     }
@@ -1423,7 +1610,7 @@ pub fn write_ladder_files(
     experiments: &[(Real, Real)],
 ) -> Result<Vec<PathBuf>, BallisticError> {
     let (md, csv) = ladder_table(rungs, speeds);
-    let mut text = format!("# Ballistic study at {} resolutions\n\n{header}\n\n{md}\n", rungs.len());
+    let mut text = format!("# Ballistic study at {}\n\n{header}\n\n{md}\n", ladder_extent(rungs));
     text.push_str(
         "Spread: (max − min) / mean over the resolutions. Step: the change from the second-finest resolution to \
          the finest, relative to the former (for a limit, with the least and most it can be within the two \
@@ -1434,11 +1621,15 @@ pub fn write_ladder_files(
          step within its brackets gives none. Edge − column: where the projectile's edge lies against the \
          target's nearest particle column at that resolution, in spacings (the lattice's phase at the rim; near a \
          limit the rim crack's first steps can depend on it, and a grid's `column_at` holds it at 0). Each \
-         resolution's own table, report and plot are in `rows-N/` (its `--set` overrides in its header).\n\n",
+         resolution's own table, report and plot are in `rows-N/` (its `--set` overrides in its header). With \
+         several lattice phases (`--phases K`, each in `phase-±F/`: the target's columns shifted so that the \
+         edge lies F of a spacing from one), a line per resolution gives the phases' envelope: the limit from the \
+         lowest held bound to the highest perforating one, a residual's mean ± half its range; the spread, step \
+         and Richardson compare those.\n\n",
     );
     for r in rungs {
         let set = if r.overrides.is_empty() { "the case as given".to_string() } else { r.overrides.join(" ") };
-        text.push_str(&format!("- {} rows: {set}\n", r.rows));
+        text.push_str(&format!("- {}: {set}\n", r.label()));
     }
     text.push_str("\n![v_r against v_i at each resolution](convergence.png)\n");
     write_report(dir, "convergence", csv, text, &ladder_plot(rungs, title, experiments))
@@ -1782,6 +1973,92 @@ mod tests {
         );
     }
 
+    /// `--phases`: the phases over one spacing, and the columns they put
+    /// next to the edge, by hand. Case II's plate at 24 rows has `h =
+    /// 10.2/23 mm` and its fine zone starts on the axis; for phase +0.25
+    /// the edge, 10 mm out, is 22.55 spacings away, so `n = round(22.55 −
+    /// 0.25) = 22` and the fine spacing becomes `10 / 22.25 = 0.449438`
+    /// mm, the column `n` at 9.88764 mm. Every phase is met at 24 and 48
+    /// rows, the rows through the thickness unchanged; a phase outside
+    /// [−½, ½], or a projectile whose edge lies outside the uniform fine
+    /// zone, is refused.
+    #[test]
+    fn lattice_phases_put_the_edge_where_asked() {
+        assert_eq!(phases(4), vec![0.0, 0.25, 0.5, -0.25]);
+        assert_eq!(phases(2), vec![0.0, 0.5]);
+        assert!((phases(3)[2] + 1.0 / 3.0).abs() < 1e-12);
+        let case = builtin("borvik-2-axisymmetric-nonlocal", &[]);
+        let projectile = select_projectile(&case, "case II", None).unwrap();
+        let (c, set) = at_phase(&case, projectile, 0.25).unwrap();
+        let e = edge_phase(&c, projectile).unwrap();
+        assert!((e.offset - 0.25).abs() < 1e-9 && (e.column - 9.887640e-3).abs() < 1e-8, "{e:?}");
+        assert_eq!(set, vec![format!("bodies.plate.rectangle.fine_spacing={:e}", 0.01 / 22.25)]);
+        assert_eq!(c.bodies[0].rectangle.layers, case.bodies[0].rectangle.layers);
+        for rows in [24, 48] {
+            let (refined, _) = at_rows(&case, rows).unwrap();
+            for p in phases(4) {
+                let (c, _) = at_phase(&refined, projectile, p).unwrap();
+                let got = edge_phase(&c, projectile).unwrap().offset;
+                assert!(((got - p + 0.5).rem_euclid(1.0) - 0.5).abs() < 1e-9, "{rows} rows, phase {p}: {got}");
+                assert!(c.validate().is_empty());
+            }
+        }
+        // a case's own column_at moves with the columns
+        let mut own = case.clone();
+        own.bodies[0].rectangle.column_at = Some(0.01);
+        let (c, set) = at_phase(&own, projectile, -0.25).unwrap();
+        assert!((edge_phase(&c, projectile).unwrap().offset + 0.25).abs() < 1e-9 && set.len() == 2, "{set:?}");
+        assert!(at_phase(&case, projectile, 0.6).unwrap_err().to_string().contains("[-0.5, 0.5]"));
+        let mut narrow = case.clone();
+        narrow.bodies[0].rectangle.fine_half_width = 5e-3;
+        let e = at_phase(&narrow, projectile, 0.25).unwrap_err().to_string();
+        assert!(e.contains("outside the target's uniform fine zone"), "{e}");
+    }
+
+    /// With several phases at a resolution the ladder compares their
+    /// envelope, by hand: at 24 rows the limits 119 ± 1 and 125 ± 1 span
+    /// 118–126, 122 ± 4, and the residuals at 200 m/s 100 and 110 give
+    /// 105 ± 5; at 48 rows 120 ± 1 and 122 ± 1 span 121 ± 2 and 104, 106
+    /// give 105 ± 1. The spread of the limits is 1/121.5 = 0.8 %; the step
+    /// 122 → 121 is −0.8 %, within (119 − 126)/126 = −5.6 % and (123 −
+    /// 118)/118 = +4.2 %; the residual's 105 → 105 is 0.0 %, within
+    /// (104 − 110)/110 = −5.5 % and (106 − 100)/100 = +6.0 %.
+    #[test]
+    fn the_ladder_table_gives_the_envelope_over_phases() {
+        let perf = |v| Verdict::Perforated { residual: v, since: 0.0 };
+        let rung = |rows: usize, phase: Real, (lo, hi): (Real, Real), at_200: Real| Rung {
+            rows,
+            spacing: 0.012 / rows as Real,
+            overrides: Vec::new(),
+            edge: Some(EdgePhase { edge: 0.01, column: 0.01, offset: phase }),
+            phase: Some(phase),
+            study: Study {
+                shots: vec![shot(200.0, perf(at_200))],
+                limit: Some(Limit { held: Some(lo), perforated: Some(hi), tol: 1.0, non_monotonic: None }),
+                ..Study::default()
+            },
+        };
+        let rungs = [
+            rung(24, 0.0, (118.0, 120.0), 100.0),
+            rung(24, 0.5, (124.0, 126.0), 110.0),
+            rung(48, 0.0, (119.0, 121.0), 104.0),
+            rung(48, 0.5, (121.0, 123.0), 106.0),
+        ];
+        assert_eq!(ladder_extent(&rungs), "2 resolutions at 2 lattice phases");
+        assert_eq!(rungs[1].label(), "24 rows, phase +0.50");
+        let (md, csv) = ladder_table(&rungs, &[200.0]);
+        assert_eq!(csv.lines().count(), 5, "one CSV line per rung: {csv}");
+        let line = |start: &str| md.lines().find(|l| l.starts_with(start)).unwrap_or_else(|| panic!("{start}: {md}"));
+        assert!(line("| 24 rows, 2 phases |").contains("| 122.00 ± 4.00 | | 105.00 ± 5.00 | 2 |"), "{md}");
+        assert!(line("| 48 rows, 2 phases |").contains("| 121.00 ± 2.00 | | 105.00 ± 1.00 |"), "{md}");
+        assert!(line("| spread").starts_with("| spread | | 0.8 % | | 0.0 % |"), "{md}");
+        let step = line("| step 24 → 48 rows");
+        assert!(step.contains("| -0.8 % (-5.6 %…+4.2 %) |") && step.contains("| +0.0 % (-5.5 %…+6.0 %) |"), "{step}");
+        // one phase per resolution reads as before: no envelope line
+        let (md, _) = ladder_table(&rungs[..1], &[200.0]);
+        assert!(!md.contains("phases |"), "{md}");
+    }
+
     #[test]
     fn the_ladder_table_gives_the_spread_of_limits_and_residuals() {
         let perf = |v| Verdict::Perforated { residual: v, since: 0.0 };
@@ -1791,6 +2068,7 @@ mod tests {
             spacing: 0.012 / rows as Real,
             overrides: Vec::new(),
             edge: None,
+            phase: None,
             study: Study {
                 shots: vec![shot(200.0, at_200), shot(300.0, perf(at_300))],
                 limit: Some(Limit { held: Some(lo), perforated: Some(hi), tol: 1.0, non_monotonic: None }),

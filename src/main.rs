@@ -565,6 +565,15 @@ struct BallisticArgs {
     /// refinement's step (coarsest first, each resolution once).
     #[arg(long, value_delimiter = ',')]
     rows: Vec<usize>,
+    /// Run the whole study at K lattice phases at the rim, at each
+    /// resolution: the target's columns shifted so that the projectile's
+    /// edge lies 0, 1/K, ... of a spacing from the nearest one, each into
+    /// [rows-N/]phase-+0.25/; convergence.md gives each resolution's
+    /// envelope over its phases (near a limit the rim crack's first steps
+    /// can depend on the phase). Needs the projectile's edge over the
+    /// target's uniform fine zone.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(2..=16))]
+    phases: Option<u64>,
     /// Continue a study in --out: a speed whose run finished there with the same case (its
     /// case.resolved.toml) is taken back as it is, a run an interrupt stopped there continues
     /// from its checkpoint; every other speed runs afresh (without --resume every speed runs
@@ -594,7 +603,7 @@ fn ballistic(
     out: Option<PathBuf>,
     args: BallisticArgs,
 ) -> Result<()> {
-    use plugsim::ballistic::{at_rows, read_experiments, select_projectile, write_ladder_files, Rung};
+    use plugsim::ballistic::{at_phase, at_rows, read_experiments, select_projectile, write_ladder_files, Rung};
     let projectile = select_projectile(&case, file, args.projectile.as_deref())?;
     let speeds = args.speeds();
     if speeds.is_empty() && !args.limit {
@@ -620,7 +629,24 @@ fn ballistic(
     let mut rows = args.rows.clone();
     rows.sort_unstable();
     rows.dedup();
-    let resolutions = rows.iter().map(|&r| Ok((r, at_rows(&case, r)?))).collect::<Result<Vec<_>>>()?;
+    let mut resolutions = rows.iter().map(|&r| Ok((r, at_rows(&case, r)?))).collect::<Result<Vec<_>>>()?;
+    let phases = args.phases.map_or(Vec::new(), |k| plugsim::ballistic::phases(k as usize));
+    if resolutions.is_empty() && !phases.is_empty() {
+        let own = plugsim::ballistic::target(&case).map_or(0, |b| case.bodies[b].rectangle.layers);
+        resolutions.push((own, (case.clone(), Vec::new())));
+    }
+    // Each resolution at each phase (or at its own columns), every one
+    // checked before the first run.
+    let mut grids = Vec::new();
+    for (rows, (refined, extra)) in resolutions {
+        for &phase in &phases {
+            let (shifted, more) = at_phase(&refined, projectile, phase)?;
+            grids.push((rows, Some(phase), shifted, extra.iter().chain(&more).cloned().collect()));
+        }
+        if phases.is_empty() {
+            grids.push((rows, None, refined, extra));
+        }
+    }
     let experiments = match &args.experiments {
         Some(p) => read_experiments(p)?,
         None => Vec::new(),
@@ -628,31 +654,40 @@ fn ballistic(
     let out_dir = out.unwrap_or_else(|| Path::new("runs").join(format!("ballistic-{name}")));
     let interrupt = install_interrupt_handler();
     let started = Instant::now();
-    if resolutions.is_empty() {
+    if grids.is_empty() {
         let (study, _) = one_study(case, file, set, projectile, &out_dir, &args, &experiments, &interrupt, started)?;
         return finish(&study);
     }
     let mut rungs = Vec::new();
-    for (rows, (refined, extra)) in resolutions {
+    for (rows, phase, refined, extra) in grids {
         let body = &refined.bodies[plugsim::ballistic::target(&refined).unwrap_or(0)].rectangle;
         let spacing = (body.y_max - body.y_min) / rows as f64;
-        let dir = out_dir.join(format!("rows-{rows}"));
+        let mut dir = out_dir.clone();
+        if !args.rows.is_empty() {
+            dir.push(format!("rows-{rows}"));
+        }
+        if let Some(p) = phase {
+            dir.push(format!("phase-{p:+.2}"));
+        }
         eprintln!(
-            "plugsim ballistic: {rows} rows ({:.3} mm){}",
+            "plugsim ballistic: {rows} rows ({:.3} mm){}{}",
             spacing * 1e3,
+            phase.map_or(String::new(), |p| format!(", lattice phase {p:+.2}")),
             if extra.is_empty() { String::new() } else { format!(": {}", extra.join(" ")) }
         );
         let all: Vec<String> = set.iter().chain(&extra).cloned().collect();
         let (study, edge) = one_study(refined, file, &all, projectile, &dir, &args, &experiments, &interrupt, started)?;
         let stop = study.interrupted;
-        rungs.push(Rung { rows, spacing, overrides: extra, edge, study });
+        rungs.push(Rung { rows, spacing, overrides: extra, edge, phase, study });
         if stop {
             break;
         }
     }
     let header = format!(
-        "Case {file}{}, produced by `plugsim ballistic --rows` ({} {}) on {}; total wall time {:.0} s{}.",
+        "Case {file}{}, produced by `plugsim ballistic{}{}` ({} {}) on {}; total wall time {:.0} s{}.",
         if set.is_empty() { String::new() } else { format!(" with {}", set.join(" ")) },
+        if args.rows.is_empty() { "" } else { " --rows" },
+        if phases.is_empty() { "" } else { " --phases" },
         env!("CARGO_PKG_VERSION"),
         env!("PLUGSIM_COMMIT"),
         cpu_name(),
@@ -663,7 +698,7 @@ fn ballistic(
             ""
         }
     );
-    let title = format!("{}: v_r against v_i at {} resolutions", case.title, rungs.len());
+    let title = format!("{}: v_r against v_i at {}", case.title, plugsim::ballistic::ladder_extent(&rungs));
     let files = write_ladder_files(&out_dir, &header, &title, &rungs, &speeds, &experiments)?;
     println!("{}", plugsim::ballistic::ladder_table(&rungs, &speeds).0);
     for f in files {

@@ -27,6 +27,20 @@ fn fresh_dir(name: &str) -> std::path::PathBuf {
     dir
 }
 
+/// A fresh directory holding the small plate as `small.toml`: (the
+/// directory, the case file).
+fn small_plate_file(name: &str) -> (std::path::PathBuf, std::path::PathBuf) {
+    let dir = fresh_dir(name);
+    let case = dir.join("small.toml");
+    std::fs::write(&case, small_plate()).unwrap();
+    (dir, case)
+}
+
+/// `plugsim --threads 1 ballistic CASE ARGS...`.
+fn ballistic_cli(case: &std::path::Path, args: &[&str]) -> std::process::Output {
+    common::plugsim(&[&["--threads", "1", "ballistic", case.to_str().unwrap()], args].concat())
+}
+
 fn setup(name: &str, jobs: usize) -> Setup {
     let case = Case::from_str_with(&small_plate(), "small", &[]).unwrap();
     let projectile = select_projectile(&case, "small", None).unwrap();
@@ -196,11 +210,8 @@ fn an_interrupt_keeps_the_finished_runs() {
 /// be made is refused before any run starts.
 #[test]
 fn the_command_runs_the_study_at_each_resolution() {
-    let dir = fresh_dir("rows");
-    let case = dir.join("small.toml");
-    std::fs::write(&case, small_plate()).unwrap();
-    let plugsim =
-        |args: &[&str]| common::plugsim(&[&["--threads", "1", "ballistic", case.to_str().unwrap()], args].concat());
+    let (dir, case) = small_plate_file("rows");
+    let plugsim = |args: &[&str]| ballistic_cli(&case, args);
     let out = dir.join("out");
     // Given out of order and twice: run coarsest first, each once.
     let o = plugsim(&["--rows", "9,5,9", "--speeds", "500", "--out", out.to_str().unwrap()]);
@@ -237,6 +248,47 @@ fn the_command_runs_the_study_at_each_resolution() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && stderr.contains("--speeds") && stderr.contains("'520:500:10'"), "{stderr}");
     assert!(!bad.exists(), "refused before any run");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `plugsim ballistic --phases`: the study at each lattice phase of the
+/// rim, each in its own directory with the edge where asked, and the
+/// envelope over the phases; a grid whose fine zone cannot hold the
+/// shifted column is refused before any run, naming the field.
+#[test]
+fn the_command_runs_the_study_at_each_lattice_phase() {
+    let (dir, case) = small_plate_file("phases");
+    let plugsim = |args: &[&str]| ballistic_cli(&case, args);
+    let zone = "bodies.plate.rectangle.fine_half_width=0.006";
+    let out = dir.join("out");
+    let o =
+        plugsim(&["--set", zone, "--phases", "2", "--rows", "5,9", "--speeds", "500", "--out", out.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    for rows in [5, 9] {
+        for (phase, says) in [("+0.00", "lies +0.00 of a spacing"), ("+0.50", "0.50 of a spacing")] {
+            let md = std::fs::read_to_string(out.join(format!("rows-{rows}/phase-{phase}/ballistic.md"))).unwrap();
+            assert!(md.contains("| 500.00 |") && md.contains(says), "{rows} rows, phase {phase}: {md}");
+        }
+    }
+    let md = std::fs::read_to_string(out.join("convergence.md")).unwrap();
+    assert!(md.starts_with("# Ballistic study at 2 resolutions at 2 lattice phases"), "{md}");
+    assert!(md.contains("| 5 rows, 2 phases |") && md.contains("| 9 rows, 2 phases |"), "{md}");
+    assert!(
+        md.contains("- 5 rows, phase +0.50: bodies.plate.rectangle.layers=5 bodies.plate.rectangle.fine_spacing="),
+        "{md}"
+    );
+    assert_eq!(std::fs::read_to_string(out.join("convergence.csv")).unwrap().lines().count(), 5);
+    // Spacings that grow from the middle with no uniform zone around the
+    // edge: no column to shift.
+    let bad = dir.join("bad");
+    let grown = "bodies.plate.rectangle.growth=1.2";
+    let o = plugsim(&["--set", grown, "--phases", "2", "--speeds", "500", "--out", bad.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && stderr.contains("outside the target's uniform fine zone"), "{stderr}");
+    assert!(!bad.exists(), "refused before any run");
+    let o = plugsim(&["--phases", "1", "--speeds", "500", "--out", bad.to_str().unwrap()]);
+    assert!(!o.status.success() && !bad.exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -551,9 +603,7 @@ fn the_steps_floors_on_a_cracking_run_keep_its_residual() {
 /// and `run` says it only once its output directory is accepted.
 #[test]
 fn check_and_run_state_the_projectile_s_edge_against_the_columns() {
-    let dir = fresh_dir("rim");
-    let case = dir.join("small.toml");
-    std::fs::write(&case, small_plate()).unwrap();
+    let (dir, case) = small_plate_file("rim");
     let width = "rigid_bodies.projectile.rectangle.width=0.0086";
     let line = "the projectile's edge (x = 4.300 mm) lies -0.40 of a spacing from the target's nearest particle column (x = 4.500 mm)";
     let o = common::plugsim(&["check", case.to_str().unwrap(), "--set", width]);
