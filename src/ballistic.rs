@@ -632,6 +632,11 @@ pub struct Study {
 }
 
 impl Study {
+    /// The run at `speed` (m/s), if the study has one.
+    pub fn shot_at(&self, speed: Real) -> Option<&Shot> {
+        self.shots.iter().find(|s| s.speed == speed)
+    }
+
     /// The limit as the runs read it: the search's, or in a study of
     /// speeds alone (no `--limit`) the bracket its runs give ([`bracket`];
     /// `tol` NaN: no tolerance was asked for). A side is missing where no
@@ -1024,7 +1029,7 @@ pub fn find_limit(
         if study.interrupted {
             break;
         }
-        let outcome = |v: Real, study: &Study| study.shots.iter().find(|s| s.speed == v).map(Shot::perforated);
+        let outcome = |v: Real, study: &Study| study.shot_at(v).map(Shot::perforated);
         // The `jobs` runs of a round spread over the new half of the range.
         let n = setup.jobs.max(1);
         let mut more = Vec::new();
@@ -1349,24 +1354,20 @@ impl Rung {
 /// How many resolutions and lattice phases `rungs` span: "3 resolutions",
 /// "1 resolution at 4 lattice phases".
 pub fn ladder_extent(rungs: &[Rung]) -> String {
-    let mut rows: Vec<usize> = rungs.iter().map(|r| r.rows).collect();
-    rows.sort_unstable();
-    rows.dedup();
-    let res = format!("{} resolution{}", rows.len(), if rows.len() == 1 { "" } else { "s" });
+    let resolutions = levels(rungs, &[]).len();
+    let res = format!("{resolutions} resolution{}", if resolutions == 1 { "" } else { "s" });
     match rungs.iter().filter(|r| r.phase.is_some()).count() {
         0 => res,
-        n => format!("{res} at {} lattice phases", n / rows.len().max(1)),
+        n => format!("{res} at {} lattice phases", n / resolutions.max(1)),
     }
 }
 
 /// What a ladder compares at one resolution ([`levels`]): the limit and
 /// the residual at each speed as (value, half-width).
-#[derive(Clone, Debug, PartialEq)]
-struct Level {
-    rows: usize,
-    spacing: Real,
+#[derive(Clone, Debug)]
+struct Level<'a> {
     /// The rungs at this resolution (several with `--phases`).
-    members: usize,
+    members: Vec<&'a Rung>,
     /// The bracketed limit: a rung's own, or over the phases their
     /// envelope (the lowest held bound to the highest perforating one).
     limit: Option<(Real, Real)>,
@@ -1375,10 +1376,20 @@ struct Level {
     residuals: Vec<Option<(Real, Real)>>,
 }
 
+impl Level<'_> {
+    fn rows(&self) -> usize {
+        self.members[0].rows
+    }
+
+    fn spacing(&self) -> Real {
+        self.members[0].spacing
+    }
+}
+
 /// The rungs grouped by resolution, in the order given ([`Level`]).
 /// A resolution's limit counts only if every member's is bracketed, a
 /// residual only if every member perforated at that speed.
-fn levels(rungs: &[Rung], speeds: &[Real]) -> Vec<Level> {
+fn levels<'a>(rungs: &'a [Rung], speeds: &[Real]) -> Vec<Level<'a>> {
     let mut rows: Vec<usize> = Vec::new();
     for r in rungs {
         if !rows.contains(&r.rows) {
@@ -1400,9 +1411,7 @@ fn levels(rungs: &[Rung], speeds: &[Real]) -> Vec<Level> {
                 .map(|&v| {
                     let at: Option<Vec<Real>> = members
                         .iter()
-                        .map(|r| {
-                            r.study.shots.iter().find(|s| s.speed == v).and_then(|s| s.residual()).filter(|&x| x > 0.0)
-                        })
+                        .map(|r| r.study.shot_at(v).and_then(Shot::residual).filter(|&x| x > 0.0))
                         .collect();
                     at.map(|x| {
                         let mean = x.iter().sum::<Real>() / x.len() as Real;
@@ -1410,13 +1419,7 @@ fn levels(rungs: &[Rung], speeds: &[Real]) -> Vec<Level> {
                     })
                 })
                 .collect();
-            Level {
-                rows: n,
-                spacing: members[0].spacing,
-                members: members.len(),
-                limit: limits.map(envelope),
-                residuals,
-            }
+            Level { members, limit: limits.map(envelope), residuals }
         })
         .collect()
 }
@@ -1450,7 +1453,6 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
     md.push_str(&"---|".repeat(speeds.len() + 3));
     md.push('\n');
     csv.push_str(",runs,wall_s,edge_offset\n");
-    let residual_at = |st: &Study, v: Real| st.shots.iter().find(|s| s.speed == v).and_then(|s| s.residual());
     for r in rungs {
         let st = &r.study;
         let reading = st.limit_reading();
@@ -1480,7 +1482,7 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
             st.fit.map_or(String::new(), |f| format!("{:.3}", f.v_bl)),
         ));
         for &v in speeds {
-            let vr = residual_at(st, v);
+            let vr = st.shot_at(v).and_then(Shot::residual);
             md.push_str(&match vr {
                 Some(x) if x > 0.0 => format!(" {x:.2} |"),
                 Some(_) => " held |".into(),
@@ -1499,20 +1501,19 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
     let levels = levels(rungs, speeds);
     // With --phases: each resolution's envelope over its phases, the value
     // that the spread, the step and Richardson compare.
-    for l in levels.iter().filter(|l| l.members > 1) {
-        let members: Vec<&Rung> = rungs.iter().filter(|r| r.rows == l.rows).collect();
+    for l in levels.iter().filter(|l| l.members.len() > 1) {
         md.push_str(&format!(
             "| {} rows, {} phases | {:.3} | {} | |",
-            l.rows,
-            l.members,
-            l.spacing * 1e3,
+            l.rows(),
+            l.members.len(),
+            l.spacing() * 1e3,
             l.limit.map_or("—".into(), |(v, h)| format!("{v:.2} ± {h:.2}"))
         ));
         for x in &l.residuals {
             md.push_str(&x.map_or(" — |".into(), |(v, h)| format!(" {v:.2} ± {h:.2} |")));
         }
-        let runs: usize = members.iter().map(|r| r.study.shots.len()).sum();
-        let wall: Real = members.iter().flat_map(|r| &r.study.shots).map(|s| s.wall).sum();
+        let runs: usize = l.members.iter().map(|r| r.study.shots.len()).sum();
+        let wall: Real = l.members.iter().flat_map(|r| &r.study.shots).map(|s| s.wall).sum();
         md.push_str(&format!(" {runs} | {wall:.0} | all |\n"));
     }
     let pct = |s: Option<Real>| s.map_or("—".into(), |x| format!("{:.1} %", 100.0 * x));
@@ -1526,7 +1527,7 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
     md.push_str(" | | |\n");
     // The two finest resolutions, by rows (the order given need not be).
     let mut by_rows: Vec<&Level> = levels.iter().collect();
-    by_rows.sort_by_key(|l| l.rows);
+    by_rows.sort_by_key(|l| l.rows());
     let signed = |x: Real| format!("{:+.1} %", 100.0 * x);
     let step_cell = |c: Option<(Real, Real)>, f: Option<(Real, Real)>| match (c, f) {
         (Some(c), Some(f)) if c.1 == 0.0 && f.1 == 0.0 => signed(step(c, f).0),
@@ -1539,8 +1540,8 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
     if let [.., coarse, fine] = by_rows[..] {
         md.push_str(&format!(
             "| step {} → {} rows | | {} | |",
-            coarse.rows,
-            fine.rows,
+            coarse.rows(),
+            fine.rows(),
             step_cell(coarse.limit, fine.limit)
         ));
         for k in 0..speeds.len() {
@@ -1554,11 +1555,11 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
             three
                 .iter()
                 .map(|l| {
-                    value(l).map(|(value, half_width)| convergence::Rung { spacing: l.spacing, value, half_width })
+                    value(l).map(|(value, half_width)| convergence::Rung { spacing: l.spacing(), value, half_width })
                 })
                 .collect()
         };
-        md.push_str(&format!("| Richardson, {} / {} / {} rows | | ", third.rows, second.rows, first.rows));
+        md.push_str(&format!("| Richardson, {} / {} / {} rows | | ", third.rows(), second.rows(), first.rows()));
         md.push_str(&convergence::describe(ladder(&|l| l.limit).and_then(|l| richardson(&l))));
         md.push_str(" | |");
         for k in 0..speeds.len() {
