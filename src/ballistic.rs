@@ -395,7 +395,7 @@ pub fn at_phase(case: &Case, projectile: Projectile, phase: Real) -> Result<(Cas
     }
     let no_edge = || {
         BallisticError::Settings(
-            "--phases: the projectile's edge does not lie over the target's particle columns, so it has no phase"
+            "lattice phase (--phases, --phase): the projectile's edge does not lie over the target's particle columns, so it has no phase"
                 .into(),
         )
     };
@@ -419,13 +419,13 @@ pub fn at_phase(case: &Case, projectile: Projectile, phase: Real) -> Result<(Cas
         set.push(format!("bodies.{name}.rectangle.column_at={column:e}"));
     }
     if let Some(p) = c.validate().into_iter().find(|p| p.key.starts_with(&format!("bodies[{b}].rectangle"))) {
-        return Err(BallisticError::Settings(format!("--phases {phase:+.2}: {}: {}", p.key, p.message)));
+        return Err(BallisticError::Settings(format!("lattice phase {phase:+.2}: {}: {}", p.key, p.message)));
     }
     let got = edge_phase(&c, projectile).ok_or_else(no_edge)?.offset;
     // ±½ are one phase (the edge midway between two columns)
     if ((got - phase + 0.5).rem_euclid(1.0) - 0.5).abs() > 1e-6 {
         return Err(BallisticError::Settings(format!(
-            "--phases {phase:+.2}: the edge (x = {:.4} mm) lies outside the target's uniform fine zone (within \
+            "lattice phase {phase:+.2}: the edge (x = {:.4} mm) lies outside the target's uniform fine zone (within \
              fine_half_width = {} m of refine_at = {x_f} m), whose columns the phase shifts",
             edge * 1e3,
             grid.fine_half_width

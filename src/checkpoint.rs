@@ -151,8 +151,11 @@ pub const MAGIC: [u8; 8] = *b"PLUGCKPT";
 /// ([`crate::fracture::FractureParameters::nonlocal_weight`]), version 15
 /// the detached particles and the points their search has seen eroded
 /// ([`crate::fracture::CrackGrowth::detach_isolated`]) and the kinetic
-/// energy the crack changes moved ([`crate::step::Energies::crack_changes`]).
-pub const FORMAT_VERSION: u32 = 15;
+/// energy the crack changes moved ([`crate::step::Energies::crack_changes`]),
+/// version 16 the axis as a wall of the contact
+/// ([`crate::contact::ContactSystem::with_axis`]: its switch, last forces
+/// and work).
+pub const FORMAT_VERSION: u32 = 16;
 /// Subdirectory of a run's output directory that holds its checkpoints.
 pub const DIRECTORY: &str = "checkpoints";
 /// File name extension of a checkpoint.

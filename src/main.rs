@@ -103,8 +103,9 @@ enum Command {
         /// Output directory (default: runs/ballistic-<case name>).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Boxed: the study's options are the largest of the commands'.
         #[command(flatten)]
-        args: BallisticArgs,
+        args: Box<BallisticArgs>,
     },
     /// Benchmark fixed workloads: shape functions, material kernel, force
     /// assembly, whole steps (1 and all threads), optionally whole cases.
@@ -237,7 +238,7 @@ fn dispatch(cmd: Command) -> Result<()> {
         Command::Cases => list_cases(),
         Command::Ballistic { case_file, case, set, out, args } => {
             let (case, name, file) = load(&case_file, &case, &set)?;
-            ballistic(case, &name, &file, &set, out, args)
+            ballistic(case, &name, &file, &set, out, *args)
         }
         Command::Bench { case, steps, whole, set } => bench(&case, steps, whole, &set),
         Command::Validate { out, all, only, full_time, family, set } => match family.as_str() {
@@ -572,8 +573,15 @@ struct BallisticArgs {
     /// envelope over its phases (near a limit the rim crack's first steps
     /// can depend on the phase). Needs the projectile's edge over the
     /// target's uniform fine zone.
-    #[arg(long, value_parser = clap::value_parser!(u64).range(2..=16))]
+    #[arg(long, value_parser = clap::value_parser!(u64).range(2..=16), conflicts_with = "phase")]
     phases: Option<u64>,
+    /// Run the whole study at these lattice phases at the rim only, in
+    /// spacings from the nearest column, each in [-0.5, 0.5]
+    /// (comma-separated, e.g. --phase 0.5 or --phase=-0.25,0.25), as
+    /// --phases does at its K: one phase of an ensemble, or a rung's
+    /// missing one.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    phase: Vec<f64>,
     /// Continue a study in --out: a speed whose run finished there with the same case (its
     /// case.resolved.toml) is taken back as it is, a run an interrupt stopped there continues
     /// from its checkpoint; every other speed runs afresh (without --resume every speed runs
@@ -593,6 +601,23 @@ impl BallisticArgs {
     fn speeds(&self) -> Vec<f64> {
         self.speeds.iter().flat_map(|s| s.0.iter().copied()).collect()
     }
+}
+
+/// `--phase`'s list, each phase in [-0.5, 0.5] and each with a directory
+/// of its own (`phase-+0.25`: two decimals), in the order given.
+fn distinct_phases(given: &[f64]) -> Result<Vec<f64>> {
+    let mut dirs: Vec<String> = Vec::new();
+    for &p in given {
+        if !(p.is_finite() && p.abs() <= 0.5) {
+            bail!("--phase: a lattice phase lies in [-0.5, 0.5] spacings, got {p}");
+        }
+        let dir = format!("phase-{p:+.2}");
+        if dirs.contains(&dir) {
+            bail!("--phase: two phases share the directory {dir}; give each phase once, to two decimals");
+        }
+        dirs.push(dir);
+    }
+    Ok(given.to_vec())
 }
 
 fn ballistic(
@@ -630,7 +655,10 @@ fn ballistic(
     rows.sort_unstable();
     rows.dedup();
     let mut resolutions = rows.iter().map(|&r| Ok((r, at_rows(&case, r)?))).collect::<Result<Vec<_>>>()?;
-    let phases = args.phases.map_or(Vec::new(), |k| plugsim::ballistic::phases(k as usize));
+    let phases = match args.phases {
+        Some(k) => plugsim::ballistic::phases(k as usize),
+        None => distinct_phases(&args.phase)?,
+    };
     if resolutions.is_empty() && !phases.is_empty() {
         let own = plugsim::ballistic::target(&case).map_or(0, |b| case.bodies[b].rectangle.layers);
         resolutions.push((own, (case.clone(), Vec::new())));
@@ -687,7 +715,11 @@ fn ballistic(
         "Case {file}{}, produced by `plugsim ballistic{}{}` ({} {}) on {}; total wall time {:.0} s{}.",
         if set.is_empty() { String::new() } else { format!(" with {}", set.join(" ")) },
         if args.rows.is_empty() { "" } else { " --rows" },
-        if phases.is_empty() { "" } else { " --phases" },
+        match (args.phases, phases.is_empty()) {
+            (Some(_), _) => " --phases",
+            (None, false) => " --phase",
+            (None, true) => "",
+        },
         env!("CARGO_PKG_VERSION"),
         env!("PLUGSIM_COMMIT"),
         cpu_name(),
@@ -1194,6 +1226,12 @@ fn drive(
     if let Some(n) = s.floor_eroded {
         println!(
             "  erosion at the step's floor (time.erode_failed_below, not in SPEC §5): {n} fractured points eroded, of those above"
+        );
+    }
+    if s.axis_energy != 0.0 {
+        println!(
+            "  axis: particles reached the axis and were held on it (contact.axis); it took {:.4e} J of their radial kinetic energy",
+            s.axis_energy
         );
     }
     match s.exposed.contacts {

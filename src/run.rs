@@ -139,6 +139,10 @@ pub struct RunSummary {
     /// [`crate::fracture::CrackGrowth::detach_isolated`]) and when, s, in
     /// order.
     pub detached: Vec<(usize, Real)>,
+    /// The radial kinetic energy the axis took from particles that reached
+    /// it, J (`−`[`crate::contact::ContactSystem::axis_work`]; 0 where none
+    /// did, or without a contact stage).
+    pub axis_energy: Real,
     /// Particles that joined the contact slaves by exposure, and when they
     /// touched a rigid body ([`crate::contact::ContactSystem::admit_exposed`]).
     pub exposed: crate::output::ExposedSummary,
@@ -249,7 +253,8 @@ fn build_simulation_without_cracks(case: &Case) -> Result<Simulation, RunError> 
         let switches = DeformableSwitches { bodies: case.contact.deformable, self_contact: case.contact.self_contact };
         let ranges: Vec<_> = model.bodies.iter().map(|b| b.particles.clone()).collect();
         let masters = DeformableMasters::of_bodies(&model.particles, &ranges, switches);
-        let contact = ContactSystem::new(bodies, slaves, case.contact)?.with_deformable(masters);
+        let axis = case.geometry.mode == crate::geometry::GeometryMode::Axisymmetric && case.contact.axis;
+        let contact = ContactSystem::new(bodies, slaves, case.contact)?.with_deformable(masters).with_axis(axis);
         Simulation::with_contact(model, rule, contact)
     };
     check_time_step(&sim, case.time.end)?;
@@ -563,6 +568,7 @@ fn time_loop(
         floor_eroded: sim.floors.erosion.and(sim.stable.as_ref()).map(|s| s.eroded),
         detached: sim.cracks.as_ref().map_or_else(Vec::new, |c| c.detached.clone()),
         exposed: crate::output::exposed_contact_summary(&history),
+        axis_energy: sim.contact.as_ref().map_or(0.0, |c| -c.axis_work()),
         cracks,
         tip_damage,
         tip_hardening,

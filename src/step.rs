@@ -545,7 +545,7 @@ impl Simulation {
             wp += s.work_on_particles;
             wb += s.work_on_body;
         }
-        self.energies.contact_work = wp + contact.deformable_work();
+        self.energies.contact_work = wp + contact.deformable_work() + contact.axis_work();
         self.energies.rigid_work = wb;
         self.energies.rigid_kinetic = rigid_kinetic_energy(contact);
         Ok(())

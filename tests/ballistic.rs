@@ -289,6 +289,47 @@ fn the_command_runs_the_study_at_each_lattice_phase() {
     assert!(!bad.exists(), "refused before any run");
     let o = plugsim(&["--phases", "1", "--speeds", "500", "--out", bad.to_str().unwrap()]);
     assert!(!o.status.success() && !bad.exists());
+    // `--phase` runs the phases named, and only those: the 9-row rung's
+    // edge midway between two columns, and a quarter spacing inward of a
+    // column (the same fitted spacing as `--phases 2`'s and `--phases 4`'s).
+    let one = dir.join("one");
+    let o = plugsim(&[
+        "--set",
+        zone,
+        "--phase=-0.25,0.5",
+        "--rows",
+        "9",
+        "--speeds",
+        "500",
+        "--out",
+        one.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    let phases: Vec<String> =
+        std::fs::read_dir(one.join("rows-9")).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+    assert_eq!(phases.iter().filter(|p| p.starts_with("phase-")).count(), 2, "{phases:?}");
+    for (phase, says) in [("-0.25", "lies -0.25 of a spacing"), ("+0.50", "0.50 of a spacing")] {
+        let md = std::fs::read_to_string(one.join(format!("rows-9/phase-{phase}/ballistic.md"))).unwrap();
+        assert!(md.contains("| 500.00 |") && md.contains(says), "phase {phase}: {md}");
+    }
+    let half = |d: &std::path::Path| {
+        let csv = std::fs::read_to_string(d.join("rows-9/phase-+0.50/ballistic.csv")).unwrap();
+        csv.lines().nth(1).unwrap().split(',').take(3).collect::<Vec<_>>().join(",")
+    };
+    assert_eq!(half(&one), half(&out), "the same run as --phases 2's");
+    let md = std::fs::read_to_string(one.join("convergence.md")).unwrap();
+    assert!(md.starts_with("# Ballistic study at 1 resolution at 2 lattice phases") && md.contains("--phase`"), "{md}");
+    // Out of range, twice the same directory, or with --phases: refused
+    // before any run.
+    for bad_phase in [&["--phase", "0.6"][..], &["--phase", "0.25,0.251"], &["--phase", "0.25", "--phases", "2"]] {
+        let mut args = vec!["--set", zone, "--speeds", "500", "--out", bad.to_str().unwrap()];
+        args.extend_from_slice(bad_phase);
+        let o = plugsim(&args);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && !bad.exists(), "{bad_phase:?}: {stderr}");
+        assert!(stderr.contains("--phase"), "{bad_phase:?}: {stderr}");
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -422,20 +422,19 @@ fn checkpoint_of_another_format_version_is_refused_naming_both() {
     }
 }
 
-/// Format 14 (postcard, before the detached particles, the points their
-/// search has seen eroded and the crack changes' kinetic energy) is refused, naming both versions, rather
-/// than misread.
+/// Format 15 (postcard, before the axis as a wall of the contact) is
+/// refused, naming both versions, rather than misread.
 #[test]
 fn older_format_version_checkpoint_is_refused_naming_both_versions() {
-    assert_eq!(FORMAT_VERSION, 15);
+    assert_eq!(FORMAT_VERSION, 16);
     let case = case(STRIKE, &["time.end=1e-6"]);
-    let dir = scratch("version-14");
+    let dir = scratch("version-15");
     let path = run_until(&case, &dir, 2);
-    corrupt(&path, 8, &14u32.to_le_bytes());
+    corrupt(&path, 8, &15u32.to_le_bytes());
     let e = checkpoint::read(&path).unwrap_err().to_string();
-    assert!(e.contains("format version 14 ") && e.contains("reads format version 15"), "{e}");
+    assert!(e.contains("format version 15 ") && e.contains("reads format version 16"), "{e}");
     let e = resume(&config(&dir, None), &mut |_| {}).unwrap_err().to_string();
-    assert!(e.contains("format version 14 ") && e.contains("format version 15"), "{e}");
+    assert!(e.contains("format version 15 ") && e.contains("format version 16"), "{e}");
 }
 
 #[test]

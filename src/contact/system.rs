@@ -77,6 +77,11 @@ pub struct ContactParameters {
     /// the velocity-jump tip); with it the residuals and the limits move
     /// (same section), so it is an option, not yet the default model's.
     pub self_contact: bool,
+    /// In axisymmetry, the axis `r = 0` is a frictionless wall for every
+    /// particle off it ([`ContactSystem::with_axis`]): no material crosses
+    /// to negative radii. Default on; off gives the runs before it (the
+    /// same bits wherever no particle reached the axis).
+    pub axis: bool,
 }
 
 /// Reach of [`ContactSystem::admit_exposed`], in the particle's spacing `h`.
@@ -93,6 +98,7 @@ impl Default for ContactParameters {
             admit_exposed: true,
             deformable: true,
             self_contact: false,
+            axis: true,
         }
     }
 }
@@ -326,6 +332,16 @@ pub struct ContactSystem {
     /// `Σ f_J·ΔU_J`, J (both sides of every pair; its negative is the
     /// energy those contacts dissipated).
     deformable_work: Real,
+    /// Whether the axis `r = 0` is a wall ([`Self::with_axis`]).
+    axis: bool,
+    /// Forces of the axis pairs applied in the last `compute_forces`:
+    /// (particle, f_J, the particle's `V^{n−½}`).
+    applied_axis: Vec<(u32, Vec2, Vec2)>,
+    /// Particles held at the axis in the last `compute_forces`.
+    axis_contacts: usize,
+    /// Cumulative work of the axis forces on the particles, J (≤ 0: the
+    /// radial kinetic energy a ring loses when it meets itself).
+    axis_work: Real,
     /// Scratch: (particle, weight) rows of the gap points and, for
     /// inverse-distance spreading, of the forces; the pairs being solved.
     /// Not in checkpoints (this and `gap_points`): cleared, or resized and
@@ -373,6 +389,10 @@ impl ContactSystem {
             segment_contacts: Vec::new(),
             applied_deformable: Vec::new(),
             deformable_work: 0.0,
+            axis: false,
+            applied_axis: Vec::new(),
+            axis_contacts: 0,
+            axis_work: 0.0,
             gap_w: Vec::new(),
             force_w: Vec::new(),
             candidates: Vec::new(),
@@ -383,6 +403,42 @@ impl ContactSystem {
     /// The same system with deformable masters ([`super::deformable`]).
     pub fn with_deformable(mut self, masters: DeformableMasters) -> Self {
         self.deformable = masters;
+        self
+    }
+
+    /// The same system with the axis of an axisymmetric model as a wall
+    /// (`axis`: the model is axisymmetric and [`ContactParameters::axis`]
+    /// is on).
+    ///
+    /// # Deviations
+    /// SPEC §8 has no contact with the axis: the particles on it are held
+    /// radially (`ON_AXIS`, `FIX_X`), and nothing keeps any other particle
+    /// from crossing it. A particle at `r < 0` is a ring of negative radius:
+    /// its points' hoop stretch `r/R` turns negative, and a free one flies
+    /// on to any radius. Both happened: in Case I's plate at 24 rows and
+    /// 298 m/s (the default model, lattice phases 0 and ½), the plug's
+    /// interior split along a crack toward the axis, failed material was
+    /// squeezed inward along it at 500–700 m/s, and four crack-face and
+    /// interior particles crossed the axis and ended at `r` = −37 to
+    /// −69 mm (`docs/validation.md`, "Material that crossed the axis").
+    /// Here every particle off the axis whose contact-free predicted
+    /// position (its physical point, with shape-function spreading) would
+    /// end the step at `r < 0` is paired with the axis, normal `+e_r`, in
+    /// the same projected Gauss–Seidel solve as the other pairs, without
+    /// friction and without a reaction: the axis is where a ring meets
+    /// itself, and the radial momentum of an axisymmetric body is no
+    /// conserved quantity (its axial momentum is, and the wall's force has
+    /// no axial part). The one-step force stops the ring's radial motion
+    /// at the axis, a perfectly inelastic meeting; the radial kinetic
+    /// energy it takes is the work of the axis forces
+    /// ([`Self::axis_work`]), booked with the contact work in the energy
+    /// balance. A particle that starts a step across the axis is held at
+    /// its depth ([`gap_floor`]). Where no particle reaches the axis
+    /// nothing changes, to the bit. In 3D there is no axis; a symmetry
+    /// plane of a 3D model would be the same wall. Test:
+    /// `no_particle_crosses_the_axis`.
+    pub fn with_axis(mut self, axis: bool) -> Self {
+        self.axis = axis;
         self
     }
 
@@ -451,7 +507,7 @@ impl ContactSystem {
     /// [`BodySample::work_on_particles`] and [`BodySample::work_on_body`]),
     /// with that of the deformable contacts ([`Self::deformable_work`]).
     pub fn contact_work(&self) -> Real {
-        self.work_on_particles.iter().chain(&self.work_on_body).sum::<Real>() + self.deformable_work
+        self.work_on_particles.iter().chain(&self.work_on_body).sum::<Real>() + self.deformable_work + self.axis_work
     }
 
     /// Cumulative work of the deformable contacts' forces on the particles
@@ -459,6 +515,18 @@ impl ContactSystem {
     /// dissipated (≥ 0 for a well-behaved contact).
     pub fn deformable_work(&self) -> Real {
         self.deformable_work
+    }
+
+    /// Cumulative work of the axis forces on the particles, J
+    /// ([`Self::with_axis`]); its negative is the radial kinetic energy the
+    /// axis took.
+    pub fn axis_work(&self) -> Real {
+        self.axis_work
+    }
+
+    /// Particles held at the axis in the last [`Self::compute_forces`].
+    pub fn axis_contacts(&self) -> usize {
+        self.axis_contacts
     }
 
     /// Deformable contacts of the last [`Self::compute_forces`].
@@ -581,6 +649,8 @@ impl ContactSystem {
         self.applied.clear();
         self.segment_contacts.clear();
         self.applied_deformable.clear();
+        self.applied_axis.clear();
+        self.axis_contacts = 0;
         self.candidates.clear();
         self.gap_w.clear();
         self.force_w.clear();
@@ -673,6 +743,10 @@ impl ContactSystem {
         // deformable pairs solves exactly what it did before).
         let physical = (spreading == Spreading::ShapeFunction).then_some(&self.gap_points[..]);
         self.deformable.candidates(input, self.slaves.particles(), physical, &mut self.gap_w, &mut self.candidates)?;
+        // The axis last, for the same reason.
+        if self.axis {
+            self.axis_candidates(input, spreading)?;
+        }
 
         // 2. Projected Gauss–Seidel on the penetrating pairs; f_contact holds
         // the forces of the current iterate.
@@ -692,6 +766,7 @@ impl ContactSystem {
                 let gap = (c.gap - c.gap_floor) + dt * dt_v * c.normal.dot(&du);
                 let f_n = (c.f_n + one_step_normal_force(c.mass_normal, gap, dt * dt_v)).max(0.0);
                 let v_t = c.slip_velocity + dt_v * c.tangent.dot(&du);
+                let mu = if matches!(c.master, Master::Axis) { 0.0 } else { mu };
                 let (f_t, slipping) = coulomb_cap(c.f_t + stick_force(c.mass_tangent, v_t, dt_v), mu * f_n);
                 let delta = c.normal * (f_n - c.f_n) + c.tangent * (f_t - c.f_t);
                 if delta != Vec2::zeros() {
@@ -724,6 +799,18 @@ impl ContactSystem {
             let force = c.normal * c.f_n + c.tangent * c.f_t;
             let pairing = match c.master {
                 Master::Rigid(pairing) => pairing,
+                Master::Axis => {
+                    // The ring meets itself: nothing to react.
+                    let rows = if id { &self.force_w[..] } else { &self.gap_w[..] };
+                    for &(j, w) in &rows[c.force_rows.0 as usize..c.force_rows.1 as usize] {
+                        let f = force * w;
+                        f_contact[j as usize] += f;
+                        total += f;
+                        self.applied_axis.push((j, f, input.v[j as usize]));
+                    }
+                    self.axis_contacts += 1;
+                    continue;
+                }
                 Master::Segment { segment, lambda } => {
                     // Both sides are in the one row: nothing to react.
                     for &(j, w) in &self.gap_w[c.force_rows.0 as usize..c.force_rows.1 as usize] {
@@ -775,6 +862,49 @@ impl ContactSystem {
         Ok(StepReport { active_contacts: self.contacts.len(), force_on_particles: total, iterations })
     }
 
+    /// The axis pairs of this step ([`Self::with_axis`]): every particle
+    /// off the axis whose contact-free predicted gap point ends the step at
+    /// `r < 0`, in particle order. Only particles whose generalized
+    /// position lies within two supports of the axis are predicted (a
+    /// physical point lies within a support of its particle's).
+    fn axis_candidates(&mut self, input: &StepInput, spreading: Spreading) -> Result<(), ContactError> {
+        let near: Vec<(usize, GapPoint)> = (0..input.x0.len())
+            .into_par_iter()
+            .filter(|&i| {
+                !input.flags[i].has(ParticleFlags::ON_AXIS) && input.x0[i].x + input.u[i].x < 2.0 * input.support[i]
+            })
+            .map(|i| predict_gap_point(input, i, spreading).map(|g| (i, g)))
+            .filter(|r| r.as_ref().map_or(true, |(_, g)| g.predicted.x < 0.0))
+            .collect::<Result<_, _>>()?;
+        let normal = Vec2::new(1.0, 0.0);
+        for (i, g) in near {
+            let start = self.gap_w.len() as u32;
+            match spreading {
+                Spreading::None | Spreading::InverseDistance => self.gap_w.push((i as u32, 1.0)),
+                Spreading::ShapeFunction => shape_row(input, i, &mut self.gap_w)?,
+            }
+            let gap_rows = (start, self.gap_w.len() as u32);
+            // Inverse-distance spreading reads the forces' rows from
+            // `force_w`: the axis spreads its force as the gap point reads.
+            let force_rows = if spreading == Spreading::InverseDistance {
+                let from = self.force_w.len() as u32;
+                self.force_w.extend_from_slice(&self.gap_w[gap_rows.0 as usize..gap_rows.1 as usize]);
+                (from, self.force_w.len() as u32)
+            } else {
+                gap_rows
+            };
+            let row = &self.gap_w[gap_rows.0 as usize..gap_rows.1 as usize];
+            let tangent = Vec2::new(0.0, 1.0);
+            let (c_n, c_t) = row_compliance(input, row, row, &normal, &tangent);
+            self.candidates.push(
+                Candidate::new(i as u32, Master::Axis, gap_rows, force_rows, g.predicted.x, normal)
+                    .with_motion(0.0, c_n, c_t)
+                    .with_start_gap(g.now.x, input.spacing[i]),
+            );
+        }
+        Ok(())
+    }
+
     /// Finish the step (module doc, stage 3): `v` holds the particles' new
     /// velocities `V^{n+½}`. Advances every body under its reaction
     /// ([`RigidBody::advance`]) and accumulates the contact work `Σ f·Δx`
@@ -805,6 +935,9 @@ impl ContactSystem {
         for &(j, f, v_old) in &self.applied_deformable {
             self.deformable_work += 0.5 * dt_v * f.dot(&(v_old + v[j as usize]));
         }
+        for &(j, f, v_old) in &self.applied_axis {
+            self.axis_work += 0.5 * dt_v * f.dot(&(v_old + v[j as usize]));
+        }
         for (b, body) in self.bodies.iter_mut().enumerate() {
             let v_old = body.velocity;
             body.advance(self.reaction[b], dt_v, dt);
@@ -822,6 +955,9 @@ pub(super) enum Master {
     /// A deformable master segment at parameter `lambda`: the gap row holds
     /// both sides, and so does the force ([`super::deformable`]).
     Segment { segment: [u32; 2], lambda: Real },
+    /// The axis `r = 0` of an axisymmetric model, frictionless and without
+    /// a reaction ([`ContactSystem::with_axis`]).
+    Axis,
 }
 
 /// A penetrating slave–master pair during the force solve.
