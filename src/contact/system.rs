@@ -417,8 +417,8 @@ impl ContactSystem {
     /// its points' hoop stretch `r/R` turns negative, and a free one flies
     /// on to any radius. Both happened: in Case I's plate at 24 rows and
     /// 298 m/s (the default model, lattice phases 0 and ½), the plug's
-    /// interior split along a crack toward the axis, failed material was
-    /// squeezed inward along it at 500–700 m/s, and four crack-face and
+    /// interior split along a crack toward the axis, crack-face material
+    /// was squeezed inward along it at 500–1,000 m/s, and four crack-face and
     /// interior particles crossed the axis and ended at `r` = −37 to
     /// −69 mm (`docs/validation.md`, "Material that crossed the axis").
     /// Here every particle off the axis whose contact-free predicted
@@ -505,7 +505,8 @@ impl ContactSystem {
 
     /// Total cumulative contact work over all bodies, J (see
     /// [`BodySample::work_on_particles`] and [`BodySample::work_on_body`]),
-    /// with that of the deformable contacts ([`Self::deformable_work`]).
+    /// with that of the deformable contacts ([`Self::deformable_work`]) and
+    /// of the axis ([`Self::axis_work`]).
     pub fn contact_work(&self) -> Real {
         self.work_on_particles.iter().chain(&self.work_on_body).sum::<Real>() + self.deformable_work + self.axis_work
     }
@@ -868,14 +869,23 @@ impl ContactSystem {
     /// position lies within two supports of the axis are predicted (a
     /// physical point lies within a support of its particle's).
     fn axis_candidates(&mut self, input: &StepInput, spreading: Spreading) -> Result<(), ContactError> {
-        let near: Vec<(usize, GapPoint)> = (0..input.x0.len())
+        let near_axis = |i: usize| {
+            !input.flags[i].has(ParticleFlags::ON_AXIS) && input.x0[i].x + input.u[i].x < 2.0 * input.support[i]
+        };
+        let crossing: Result<Vec<(usize, GapPoint)>, ContactError> = (0..input.x0.len())
             .into_par_iter()
-            .filter(|&i| {
-                !input.flags[i].has(ParticleFlags::ON_AXIS) && input.x0[i].x + input.u[i].x < 2.0 * input.support[i]
-            })
+            .filter(|&i| near_axis(i))
             .map(|i| predict_gap_point(input, i, spreading).map(|g| (i, g)))
             .filter(|r| r.as_ref().map_or(true, |(_, g)| g.predicted.x < 0.0))
-            .collect::<Result<_, _>>()?;
+            .collect();
+        // On an error, name the first particle in order that fails, as a
+        // serial loop would (and as the slaves' prediction does).
+        let near = crossing.map_err(|e| {
+            (0..input.x0.len())
+                .filter(|&i| near_axis(i))
+                .find_map(|i| predict_gap_point(input, i, spreading).err())
+                .unwrap_or(e)
+        })?;
         let normal = Vec2::new(1.0, 0.0);
         for (i, g) in near {
             let start = self.gap_w.len() as u32;
