@@ -603,13 +603,18 @@ impl BallisticArgs {
     }
 }
 
-/// `--phase`'s list, each phase with a directory of its own (`phase-+0.25`:
-/// two decimals), in the order given; `ballistic::at_phase` checks each
-/// phase's range.
+/// The directory of a study at lattice phase `p`: `phase-+0.25` (two
+/// decimals).
+fn phase_dir(p: f64) -> String {
+    format!("phase-{p:+.2}")
+}
+
+/// `--phase`'s list, each phase with a directory of its own ([`phase_dir`]),
+/// in the order given; `ballistic::at_phase` checks each phase's range.
 fn distinct_phases(given: &[f64]) -> Result<Vec<f64>> {
     let mut dirs: Vec<String> = Vec::new();
     for &p in given {
-        let dir = format!("phase-{p:+.2}");
+        let dir = phase_dir(p);
         if dirs.contains(&dir) {
             bail!("--phase: two phases share the directory {dir}; give each phase once, to two decimals");
         }
@@ -693,7 +698,7 @@ fn ballistic(
             dir.push(format!("rows-{rows}"));
         }
         if let Some(p) = phase {
-            dir.push(format!("phase-{p:+.2}"));
+            dir.push(phase_dir(p));
         }
         eprintln!(
             "plugsim ballistic: {rows} rows ({:.3} mm){}{}",
