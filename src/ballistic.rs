@@ -558,6 +558,11 @@ pub struct Shot {
     /// erode_failed_below`).
     #[serde(default)]
     pub floor_eroded: u64,
+    /// The radial kinetic energy the axis took from particles that reached
+    /// it, J (0 where none did, or in plane strain; `contact.axis`,
+    /// [`crate::run::RunSummary::axis_energy`]).
+    #[serde(default)]
+    pub axis_energy: Real,
     /// Particles detached from their body (0 without it, `fracture.detach_below`).
     #[serde(default)]
     pub detached: usize,
@@ -970,6 +975,7 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
                 dir,
                 added_mass: s.mass_scaling.map_or(0.0, |a| a.mass),
                 floor_eroded: s.floor_eroded.unwrap_or(0),
+                axis_energy: s.axis_energy,
                 detached: s.detached.len(),
             };
             let kept = FinishedRun { writer: crate::checkpoint::this_writer(), shot: shot.clone() };
@@ -1276,6 +1282,15 @@ pub fn report(header: &str, study: &Study) -> String {
              and they left their body's shape functions: at most {} in one run, at {:.2} m/s; each run's summary \
              names them.\n\n",
             most.detached, most.speed
+        ));
+    }
+    if let Some(most) =
+        study.shots.iter().filter(|x| x.axis_energy > 0.0).max_by(|a, b| a.axis_energy.total_cmp(&b.axis_energy))
+    {
+        s.push_str(&format!(
+            "The axis (`contact.axis`, not in SPEC §8) held particles that reached it, taking their radial kinetic \
+             energy: at most {:.4e} J in one run, at {:.2} m/s; each run's summary gives its own.\n\n",
+            most.axis_energy, most.speed
         ));
     }
     s.push_str(&format!("{DEFINITIONS}\n\n![v_r against v_i](ballistic.png)\n"));
@@ -1756,6 +1771,7 @@ mod tests {
             wall: 0.0,
             added_mass: 0.0,
             floor_eroded: 0,
+            axis_energy: 0.0,
             detached: 0,
             dir: PathBuf::new(),
         }
@@ -1826,8 +1842,9 @@ mod tests {
         assert_eq!(Study { shots: vec![], limit: None, ..study.clone() }.limit_reading(), None);
     }
 
-    /// The step's floors and the detached particles are named in the
-    /// report, each with its largest run, and only where they acted.
+    /// The step's floors, the detached particles and the axis's work are
+    /// named in the report, each with its largest run, and only where they
+    /// acted.
     #[test]
     fn the_report_names_the_steps_floors_where_they_acted() {
         let perf = |v| Verdict::Perforated { residual: v, since: 0.0 };
@@ -1841,7 +1858,10 @@ mod tests {
         };
         let text = report("header", &study(&shots));
         assert!(
-            !text.contains("mass_scaling") && !text.contains("erode_failed_below") && !text.contains("detach_below"),
+            !text.contains("mass_scaling")
+                && !text.contains("erode_failed_below")
+                && !text.contains("detach_below")
+                && !text.contains("contact.axis"),
             "{text}"
         );
         shots[0].added_mass = 2e-5;
@@ -1849,7 +1869,12 @@ mod tests {
         shots[1].floor_eroded = 3;
         shots[2].floor_eroded = 12;
         shots[0].detached = 2;
+        shots[2].axis_energy = 3.7;
         let text = report("header", &study(&shots));
+        assert!(
+            text.contains("`contact.axis`") && text.contains("at most 3.7000e0 J in one run, at 190.00 m/s"),
+            "{text}"
+        );
         assert!(
             text.contains("`fracture.detach_below`") && text.contains("at most 2 in one run, at 150.00 m/s"),
             "{text}"
