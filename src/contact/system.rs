@@ -434,7 +434,12 @@ impl ContactSystem {
     /// ([`Self::axis_work`]), booked with the contact work in the energy
     /// balance. A particle that starts a step across the axis is held at
     /// its depth ([`gap_floor`]). Where no particle reaches the axis
-    /// nothing changes, to the bit. In 3D there is no axis; a symmetry
+    /// nothing changes, to the bit. A case without a contact stage (no
+    /// projectile, one body, no self-contact) has no axis wall, and needs
+    /// none: its cracks nucleate only at slave particles
+    /// ([`crate::fracture::CrackGrowth`]), which only a contact stage
+    /// marks, so its body stays whole and is held on the axis by its axis
+    /// particles (a point that inverts stops the run). In 3D there is no axis; a symmetry
     /// plane of a 3D model would be the same wall. Test:
     /// `no_particle_crosses_the_axis`.
     pub fn with_axis(mut self, axis: bool) -> Self {
