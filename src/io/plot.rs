@@ -9,6 +9,7 @@
 use std::path::Path;
 use std::sync::OnceLock;
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -220,21 +221,7 @@ fn draw_line_plot(root: &Area, plot: &LinePlot) -> Result<(), String> {
         builder.caption(&plot.title, (FONT, caption_size(&plot.title, root.dim_in_pixel().0)));
     }
     let mut chart = builder.build_cartesian_2d(x0..x1, y0..y1).map_err(|e| e.to_string())?;
-    let x_ticks = tick_formatter(x0, x1);
-    let y_ticks = tick_formatter(y0, y1);
-    let (x_count, y_count) = label_counts(chart.plotting_area().dim_in_pixel());
-    chart
-        .configure_mesh()
-        .x_labels(x_count)
-        .y_labels(y_count)
-        .x_desc(plot.x_label.as_str())
-        .y_desc(plot.y_label.as_str())
-        .label_style((FONT, 16))
-        .axis_desc_style((FONT, 20))
-        .x_label_formatter(&x_ticks)
-        .y_label_formatter(&y_ticks)
-        .draw()
-        .map_err(|e| e.to_string())?;
+    draw_axes(&mut chart, ((x0, x1), (y0, y1)), (&plot.x_label, &plot.y_label), true)?;
 
     for (i, series) in plot.series.iter().enumerate() {
         let style = PALETTE[i % PALETTE.len()].stroke_width(2);
@@ -315,22 +302,7 @@ fn draw_field_plot(root: &Area, plot: &FieldPlot) -> Result<(), String> {
         .y_label_area_size(Y_LABEL_AREA)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(|e| e.to_string())?;
-    let x_ticks = tick_formatter(x0, x1);
-    let y_ticks = tick_formatter(y0, y1);
-    let (x_count, y_count) = label_counts(chart.plotting_area().dim_in_pixel());
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_labels(x_count)
-        .y_labels(y_count)
-        .x_desc(plot.x_label.as_str())
-        .y_desc(plot.y_label.as_str())
-        .label_style((FONT, 16))
-        .axis_desc_style((FONT, 20))
-        .x_label_formatter(&x_ticks)
-        .y_label_formatter(&y_ticks)
-        .draw()
-        .map_err(|e| e.to_string())?;
+    draw_axes(&mut chart, ((x0, x1), (y0, y1)), (&plot.x_label, &plot.y_label), false)?;
 
     let finite_values = finite_min_max(plot.values.iter().copied())
         .map(|(lo, hi)| plot.value_floor.map_or((lo, hi), |floor| (floor, hi.max(floor))));
@@ -408,6 +380,35 @@ fn draw_field_plot(root: &Area, plot: &FieldPlot) -> Result<(), String> {
 
 /// Maximum numbers of tick labels on the x and y axes of a plot area of
 /// `pixels` (width, height), so that labels do not overlap.
+/// The axes of a chart over `ranges` (x, y): tick labels as many as fit,
+/// formatted to the range, the axis `labels` (x, y), and the grid lines
+/// when `mesh` (the line plots; a field plot draws none over its points).
+fn draw_axes<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    ranges: ((f64, f64), (f64, f64)),
+    labels: (&str, &str),
+    mesh: bool,
+) -> Result<(), String> {
+    let ((x0, x1), (y0, y1)) = ranges;
+    let x_ticks = tick_formatter(x0, x1);
+    let y_ticks = tick_formatter(y0, y1);
+    let (x_count, y_count) = label_counts(chart.plotting_area().dim_in_pixel());
+    let mut axes = chart.configure_mesh();
+    if !mesh {
+        axes.disable_mesh();
+    }
+    axes.x_labels(x_count)
+        .y_labels(y_count)
+        .x_desc(labels.0)
+        .y_desc(labels.1)
+        .label_style((FONT, 16))
+        .axis_desc_style((FONT, 20))
+        .x_label_formatter(&x_ticks)
+        .y_label_formatter(&y_ticks)
+        .draw()
+        .map_err(|e| e.to_string())
+}
+
 fn label_counts(pixels: (u32, u32)) -> (usize, usize) {
     ((pixels.0 / 90).clamp(2, 10) as usize, (pixels.1 / 50).clamp(2, 10) as usize)
 }
