@@ -439,8 +439,8 @@ impl ContactSystem {
     /// none: its cracks nucleate only at slave particles
     /// ([`crate::fracture::CrackGrowth`]), which only a contact stage
     /// marks, so its body stays whole and is held on the axis by its axis
-    /// particles (a point that inverts stops the run). In 3D there is no axis; a symmetry
-    /// plane of a 3D model would be the same wall. Test:
+    /// particles (a point that inverts stops the run). In 3D there is no
+    /// axis; a symmetry plane of a 3D model would be the same wall. Test:
     /// `no_particle_crosses_the_axis`.
     pub fn with_axis(mut self, axis: bool) -> Self {
         self.axis = axis;
