@@ -1260,23 +1260,21 @@ pub fn report(header: &str, study: &Study) -> String {
         )),
         None => s.push_str("Recht–Ipson fit: fewer than two perforating runs.\n\n"),
     }
-    if let Some(most) =
-        study.shots.iter().filter(|x| x.added_mass > 0.0).max_by(|a, b| a.added_mass.total_cmp(&b.added_mass))
-    {
+    if let Some(most) = largest(&study.shots, |x| x.added_mass) {
         s.push_str(&format!(
             "Mass scaling (`time.mass_scaling`, not in SPEC §5) added mass at rest to hold the step: at most {:.4e} kg \
              (kg/m in plane strain), in the run at {:.2} m/s; each run's summary gives its own.\n\n",
             most.added_mass, most.speed
         ));
     }
-    if let Some(most) = study.shots.iter().filter(|x| x.floor_eroded > 0).max_by_key(|x| x.floor_eroded) {
+    if let Some(most) = largest(&study.shots, |x| x.floor_eroded as Real) {
         s.push_str(&format!(
             "Erosion at the step's floor (`time.erode_failed_below`, not in SPEC §5) eroded fractured points to hold \
              the step: at most {} in one run, at {:.2} m/s; each run's summary gives its own.\n\n",
             most.floor_eroded, most.speed
         ));
     }
-    if let Some(most) = study.shots.iter().filter(|x| x.detached > 0).max_by_key(|x| x.detached) {
+    if let Some(most) = largest(&study.shots, |x| x.detached as Real) {
         s.push_str(&format!(
             "Detached particles (`fracture.detach_below`, not in SPEC §9): erosion left particles without material, \
              and they left their body's shape functions: at most {} in one run, at {:.2} m/s; each run's summary \
@@ -1284,9 +1282,7 @@ pub fn report(header: &str, study: &Study) -> String {
             most.detached, most.speed
         ));
     }
-    if let Some(most) =
-        study.shots.iter().filter(|x| x.axis_energy > 0.0).max_by(|a, b| a.axis_energy.total_cmp(&b.axis_energy))
-    {
+    if let Some(most) = largest(&study.shots, |x| x.axis_energy) {
         s.push_str(&format!(
             "The axis (`contact.axis`, not in SPEC §8) held particles that reached it, taking their radial kinetic \
              energy: at most {:.4e} J in one run, at {:.2} m/s; each run's summary gives its own.\n\n",
@@ -1295,6 +1291,13 @@ pub fn report(header: &str, study: &Study) -> String {
     }
     s.push_str(&format!("{DEFINITIONS}\n\n![v_r against v_i](ballistic.png)\n"));
     s
+}
+
+/// The run with the largest positive `value` (the last of equal ones), for
+/// the report's notes on what acted in which run; `None` where it acted in
+/// none.
+fn largest(shots: &[Shot], value: impl Fn(&Shot) -> Real) -> Option<&Shot> {
+    shots.iter().filter(|x| value(x) > 0.0).max_by(|a, b| value(a).total_cmp(&value(b)))
 }
 
 /// Points drawn apart: a lone point between non-finite ones is a dot.

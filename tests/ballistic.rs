@@ -322,13 +322,17 @@ fn the_command_runs_the_study_at_each_lattice_phase() {
     assert!(md.starts_with("# Ballistic study at 1 resolution at 2 lattice phases") && md.contains("--phase`"), "{md}");
     // Out of range, twice the same directory, or with --phases: refused
     // before any run.
-    for bad_phase in [&["--phase", "0.6"][..], &["--phase", "0.25,0.251"], &["--phase", "0.25", "--phases", "2"]] {
+    for (bad_phase, says) in [
+        (&["--phase", "0.6"][..], "a lattice phase lies in [-0.5, 0.5] spacings, got 0.6"),
+        (&["--phase", "0.25,0.251"], "two phases share the directory phase-+0.25"),
+        (&["--phase", "0.25", "--phases", "2"], "cannot be used with '--phases"),
+    ] {
         let mut args = vec!["--set", zone, "--speeds", "500", "--out", bad.to_str().unwrap()];
         args.extend_from_slice(bad_phase);
         let o = plugsim(&args);
         let stderr = String::from_utf8_lossy(&o.stderr);
         assert!(!o.status.success() && !bad.exists(), "{bad_phase:?}: {stderr}");
-        assert!(stderr.contains("phase"), "{bad_phase:?}: {stderr}");
+        assert!(stderr.contains(says), "{bad_phase:?}: {stderr}");
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }

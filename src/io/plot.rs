@@ -378,8 +378,6 @@ fn draw_field_plot(root: &Area, plot: &FieldPlot) -> Result<(), String> {
     Ok(())
 }
 
-/// Maximum numbers of tick labels on the x and y axes of a plot area of
-/// `pixels` (width, height), so that labels do not overlap.
 /// The axes of a chart over `ranges` (x, y): tick labels as many as fit,
 /// formatted to the range, the axis `labels` (x, y), and the grid lines
 /// when `mesh` (the line plots; a field plot draws none over its points).
@@ -409,6 +407,8 @@ fn draw_axes<DB: DrawingBackend>(
         .map_err(|e| e.to_string())
 }
 
+/// Maximum numbers of tick labels on the x and y axes of a plot area of
+/// `pixels` (width, height), so that labels do not overlap.
 fn label_counts(pixels: (u32, u32)) -> (usize, usize) {
     ((pixels.0 / 90).clamp(2, 10) as usize, (pixels.1 / 50).clamp(2, 10) as usize)
 }
