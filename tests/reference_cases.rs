@@ -275,3 +275,54 @@ fn a_projectile_is_through_one_plate_thickness_past_the_back_face() {
         assert!((got - expected).abs() < 1e-9, "{name}: through at {got} m along the flight, expected {expected}");
     }
 }
+
+/// The experiments CSVs shipped for `plugsim ballistic --experiments`
+/// (`cases/reference/*.csv`) read with the command's own reader and carry
+/// what the data file `borvik-experiments.toml` and the SPEC's table say:
+/// each nose's held shots and its published limit as points with `v_r = 0`
+/// (no more, no less), and Case I's and II's tests as
+/// [`EXPERIMENTS`] has them. A CSV edited without its source, or a source
+/// edited without its CSV, fails here.
+#[test]
+fn reference_experiment_files_agree_with_this_file() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/reference");
+    let data: toml::Table = std::fs::read_to_string(dir.join("borvik-experiments.toml")).unwrap().parse().unwrap();
+    let noses = data["nose_shapes"].as_table().unwrap();
+    let number = |v: &toml::Value| v.as_float().unwrap_or_else(|| panic!("{v} is not a number"));
+    let mut csvs: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "csv"))
+        .collect();
+    csvs.sort();
+    let mut checked = Vec::new();
+    for path in &csvs {
+        let name = path.file_stem().unwrap().to_str().unwrap();
+        let points = plugsim::ballistic::read_experiments(path).unwrap_or_else(|e| panic!("{e}"));
+        assert!(!points.is_empty(), "{name}: no points");
+        let mut expected: Vec<(Real, Real)> = match name {
+            "borvik-case-1" | "borvik-case-2" => {
+                let e = &EXPERIMENTS[if name.ends_with('1') { 0 } else { 1 }];
+                vec![(e.impact_velocity, e.residual)]
+            }
+            _ => {
+                let nose =
+                    name.strip_prefix("borvik-2002-12mm-").unwrap_or_else(|| panic!("{name}: which experiment?"));
+                let held = noses[&format!("{nose}_held_shots")].as_array().unwrap();
+                let limit = number(&noses[&format!("{nose}_ballistic_limit")]);
+                held.iter().map(|v| (number(v), 0.0)).chain([(limit, 0.0)]).collect()
+            }
+        };
+        let mut got = points.clone();
+        let by_speed = |a: &(Real, Real), b: &(Real, Real)| a.0.total_cmp(&b.0);
+        expected.sort_by(by_speed);
+        got.sort_by(by_speed);
+        assert_eq!(got, expected, "{name}");
+        checked.push(name.to_string());
+    }
+    assert_eq!(
+        checked,
+        ["borvik-2002-12mm-blunt", "borvik-2002-12mm-hemispherical", "borvik-case-1", "borvik-case-2"],
+        "every shipped experiments file is checked"
+    );
+}
