@@ -284,7 +284,7 @@ fn a_projectile_is_through_one_plate_thickness_past_the_back_face() {
 /// [`EXPERIMENTS`] has them. A CSV edited without its source, or a source
 /// edited without its CSV, fails here.
 #[test]
-fn reference_experiment_files_agree_with_this_file() {
+fn reference_experiment_files_agree_with_the_data_file() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/reference");
     let data: toml::Table = std::fs::read_to_string(dir.join("borvik-experiments.toml")).unwrap().parse().unwrap();
     let noses = data["nose_shapes"].as_table().unwrap();
@@ -300,12 +300,10 @@ fn reference_experiment_files_agree_with_this_file() {
         let name = path.file_stem().unwrap().to_str().unwrap();
         let points = plugsim::ballistic::read_experiments(path).unwrap_or_else(|e| panic!("{e}"));
         assert!(!points.is_empty(), "{name}: no points");
-        let mut expected: Vec<(Real, Real)> = match name {
-            "borvik-case-1" | "borvik-case-2" => {
-                let e = &EXPERIMENTS[if name.ends_with('1') { 0 } else { 1 }];
-                vec![(e.impact_velocity, e.residual)]
-            }
-            _ => {
+        let case = EXPERIMENTS.iter().find(|e| name == format!("borvik-{}", e.name));
+        let mut expected: Vec<(Real, Real)> = match case {
+            Some(e) => vec![(e.impact_velocity, e.residual)],
+            None => {
                 let nose =
                     name.strip_prefix("borvik-2002-12mm-").unwrap_or_else(|| panic!("{name}: which experiment?"));
                 let held = noses[&format!("{nose}_held_shots")].as_array().unwrap();
@@ -313,7 +311,7 @@ fn reference_experiment_files_agree_with_this_file() {
                 held.iter().map(|v| (number(v), 0.0)).chain([(limit, 0.0)]).collect()
             }
         };
-        let mut got = points.clone();
+        let mut got = points;
         let by_speed = |a: &(Real, Real), b: &(Real, Real)| a.0.total_cmp(&b.0);
         expected.sort_by(by_speed);
         got.sort_by(by_speed);
