@@ -64,6 +64,33 @@ pub fn ddot(a: &Tensor3, b: &Tensor3) -> Real {
     a.component_mul(b).sum()
 }
 
+/// The largest principal value `σ₁` of a symmetric tensor (the
+/// Cockcroft–Latham criterion's stress, [`crate::material::johnson_cook`]).
+/// In block form (2D kinematics, [`is_block_2d`]) the larger of the in-plane
+/// pair `c + √(((a₀₀ − a₁₁)/2)² + a₀₁²)` and the out-of-plane entry; otherwise
+/// the trigonometric closed form of the symmetric 3×3 eigenproblem (Smith,
+/// Comm. ACM 4 (1961) 168), so that the same function serves 3D. Test:
+/// `largest_principal_matches_the_symmetric_eigenvalues`.
+#[inline]
+pub fn largest_principal(t: &Tensor3) -> Real {
+    if is_block_2d(t) {
+        let c = 0.5 * (t[(0, 0)] + t[(1, 1)]);
+        let h = 0.5 * (t[(0, 0)] - t[(1, 1)]);
+        let r = h.hypot(t[(0, 1)]);
+        return (c + r).max(t[(2, 2)]);
+    }
+    let off = t[(0, 1)] * t[(0, 1)] + t[(0, 2)] * t[(0, 2)] + t[(1, 2)] * t[(1, 2)];
+    if off == 0.0 {
+        return t[(0, 0)].max(t[(1, 1)]).max(t[(2, 2)]);
+    }
+    let q = t.trace() / 3.0;
+    let p2 = (t[(0, 0)] - q).powi(2) + (t[(1, 1)] - q).powi(2) + (t[(2, 2)] - q).powi(2) + 2.0 * off;
+    let p = (p2 / 6.0).sqrt();
+    let b = (t - identity() * q) / p;
+    let r = (0.5 * b.determinant()).clamp(-1.0, 1.0);
+    q + 2.0 * p * (r.acos() / 3.0).cos()
+}
+
 /// Lift a 2D vector into 3D with a zero out-of-plane component.
 #[inline]
 pub fn lift(v: &Vec2) -> nalgebra::Vector3<Real> {
@@ -352,6 +379,37 @@ pub(crate) fn bit_test_entries(mut seed: u64, scale: Real) -> impl FnMut() -> Re
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn largest_principal_matches_the_symmetric_eigenvalues() {
+        // Block form (2D) and full 3×3 tensors, against nalgebra's
+        // symmetric eigenvalue solver.
+        let mut seed = 12345u64;
+        let mut r = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((seed >> 11) as Real / (1u64 << 53) as Real) * 2.0 - 1.0
+        };
+        for case in 0..2000 {
+            let mut t = Tensor3::new(r(), r(), r(), 0.0, r(), r(), 0.0, 0.0, r()) * 1e9;
+            if case % 2 == 0 {
+                t[(0, 2)] = 0.0;
+                t[(1, 2)] = 0.0;
+            }
+            let t = sym(&(t + t.transpose()));
+            let want = t.symmetric_eigenvalues().max();
+            let got = largest_principal(&t);
+            assert!((got - want).abs() <= 1e-9 * t.norm(), "{t} {got} {want}");
+        }
+        // Pure shear τ: σ₁ = τ; uniaxial tension σ: σ₁ = σ; equal triaxial
+        // compression: σ₁ = −p.
+        let shear = Tensor3::new(0.0, 3.0, 0.0, 3.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+        assert_eq!(largest_principal(&shear), 3.0);
+        assert_eq!(largest_principal(&Tensor3::from_diagonal(&nalgebra::Vector3::new(0.0, 5.0, 0.0))), 5.0);
+        assert_eq!(largest_principal(&(identity() * -2.0)), -2.0);
+        let mut rotated = Tensor3::new(1.0, 0.0, 2.0, 0.0, -1.0, 0.0, 2.0, 0.0, 1.0);
+        rotated = sym(&rotated);
+        assert!((largest_principal(&rotated) - 3.0).abs() < 1e-12);
+    }
     use super::*;
 
     #[test]

@@ -103,6 +103,28 @@ fn damage_cut_off_is_read_and_checked() {
     assert_eq!(w.damage.cutoff_triaxiality, Some(-1.0 / 3.0));
 }
 
+/// Cockcroft–Latham's critical work (Deviation 15 of `johnson_cook`): a
+/// case file may give it, a non-positive one is refused by its key, and the
+/// built-in material carries the tension test's value.
+#[test]
+fn cockcroft_latham_work_is_read_and_checked() {
+    let text = include_str!("../cases/borvik-1-axisymmetric-deformable.toml");
+    let line = "damage = { d1 = 100.0, d2 = 0.0, d3 = 0.0, d4 = 0.0, d5 = 0.0 }";
+    let with_w = |v: &str| text.replace(line, &line.replace(" }", &format!(", cockcroft_latham = {v} }}")));
+    let case = Case::from_str_with(&with_w("2.0e9"), "cl.toml", &[]).unwrap();
+    let Some(plugsim::material::Material::JohnsonCook(m)) = case.material("arne_tool_steel") else { panic!() };
+    assert_eq!(m.damage.cockcroft_latham, Some(2.0e9));
+    let s = match Case::from_str_with(&with_w("-1.0"), "bad.toml", &[]) {
+        Ok(_) => panic!("a negative W_c must be refused"),
+        Err(e) => e.to_string(),
+    };
+    assert!(s.contains("materials.arne_tool_steel.damage.cockcroft_latham"), "{s}");
+    let plate = Case::from_str_with(text, "plate.toml", &["bodies.plate.material=weldox_460e_cockcroft_latham".into()])
+        .unwrap();
+    let Some(plugsim::material::Material::JohnsonCook(w)) = plate.material(&plate.bodies[1].material) else { panic!() };
+    assert_eq!(w.damage.cockcroft_latham, Some(w.tension_fracture_work()));
+}
+
 #[test]
 fn all_problems_reported_at_once() {
     let t = with("density = 7850.0", "density = -1.0").replace("end = 30.0e-6", "end = -1.0");

@@ -161,9 +161,38 @@
 //!     (`σ*` is the same invariant there). Tests:
 //!     `the_cut_off_stops_damage_below_it_only`,
 //!     `tests/material.rs::upsetting_accrues_no_damage_below_the_cut_off`.
+//! 15. **Cockcroft–Latham damage (optional, beyond \[RL10\]).** With
+//!     `damage.cockcroft_latham = W_c` the damage grows as
+//!     `dD = ⟨σ₁⟩ dε̄ / W_c` (Cockcroft & Latham, J. Inst. Metals 96 (1968)
+//!     33), `σ₁` the largest principal stress (of `τ`: `J ≈ 1` in plastic
+//!     flow), instead of `dε̄/ε_f(σ*)`; a crack still forms where the
+//!     fracture criterion reads `D` (per particle or averaged). Why: the
+//!     Johnson–Cook locus depends on the triaxiality alone, so the material
+//!     under a blunt projectile's rim, sheared under pressure, accrues damage
+//!     at `1/ε_f ≈ 0.4–0.5` per unit strain, where no test supports it
+//!     (Deviation 14 cuts it off at `σ* = −1/3` by a switch). Cockcroft and
+//!     Latham's integrand depends on the Lode parameter as well as on `σ*`:
+//!     in generalized shear `σ₁ = σ̄ (σ* + 1/√3)`, so shear fractures at
+//!     `√3` times the tensile work and no damage accrues below `σ* = −1/√3`
+//!     (in axisymmetric compression below `−1/3`): a continuous cut-off
+//!     instead of a switch, and a locus that rises with the flow stress's
+//!     fall in a hot band. One constant, fixed by a tension test: the
+//!     built-in `weldox_460e_cockcroft_latham` takes `W_c` as the work of
+//!     \[RL10\]'s hardening curve up to \[RL10\]'s Johnson–Cook fracture
+//!     strain in uniaxial tension, quasi-static and at room temperature
+//!     ([`JohnsonCook::tension_fracture_work`]), so the two loci agree
+//!     there and differ elsewhere; nothing is taken from a ballistic test.
+//!     `σ₁` and `ε̄` are 3D invariants, so it carries to 3D unchanged
+//!     ([`crate::math::largest_principal`] has the 3×3 form). Tests:
+//!     `tests/material.rs::cockcroft_latham_simple_shear_matches_reference_ode`,
+//!     `cockcroft_latham_tension_fails_at_the_johnson_cook_strain`,
+//!     `cockcroft_latham_accrues_no_damage_in_compression`,
+//!     `tension_fracture_work_is_the_area_under_the_hardening_curve`.
 
 use super::{jaumann_update, Constitutive, PointState, StepKinematics, ThermalProperties};
-use crate::math::{ddot, deviator, identity, mean_stress, von_mises, von_mises_2d, Block2, Real, Tensor3};
+use crate::math::{
+    ddot, deviator, identity, largest_principal, mean_stress, von_mises, von_mises_2d, Block2, Real, Tensor3,
+};
 
 /// Floor on `ε̄` where the hardening slope `g_ε = B n ε̄ⁿ⁻¹ …` is evaluated
 /// (Deviation 1). 1e-6 is three orders below a metal's yield strain, so it
@@ -236,6 +265,12 @@ pub struct DamageConstants {
     /// locus): the formula at every triaxiality.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cutoff_triaxiality: Option<Real>,
+    /// Cockcroft–Latham critical plastic work `W_c`, Pa (Deviation 15):
+    /// where given, the damage grows as `dD = ⟨σ₁⟩ dε̄ / W_c` instead of
+    /// `dε̄/ε_f`, and `D₁ … D₅` are not used. `None` (the default, and
+    /// \[RL10\]'s): the Johnson–Cook locus.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cockcroft_latham: Option<Real>,
 }
 
 /// Johnson–Cook thermo-viscoplastic material with isotropic hypoelasticity
@@ -430,6 +465,17 @@ impl JohnsonCook {
         }
         if let Some(c) = dc.cutoff_triaxiality {
             check("damage.cutoff_triaxiality", c, c <= 0.0, "<= 0 (no damage below it)");
+            if dc.cockcroft_latham.is_some() {
+                check(
+                    "damage.cutoff_triaxiality",
+                    c,
+                    false,
+                    "not with damage.cockcroft_latham (its <σ1> is the cut-off)",
+                );
+            }
+        }
+        if let Some(w) = dc.cockcroft_latham {
+            check("damage.cockcroft_latham", w, w > 0.0 && w.is_finite(), "> 0 (Pa)");
         }
         let d_c = self.damage_coupling;
         check("damage_coupling", d_c, (0.0..=1.0).contains(&d_c), "in [0, 1] (Børvik's critical damage D_C)");
@@ -668,6 +714,31 @@ impl JohnsonCook {
         }
     }
 
+    /// Cockcroft–Latham's critical work `W_c` from a tension test on this
+    /// material's own curves (Deviation 15), Pa: the area under the
+    /// hardening curve, `∫₀^{ε_f} (A + B εⁿ) dε = A ε_f + B ε_f^{n+1}/(n+1)`,
+    /// up to the Johnson–Cook fracture strain of uniaxial tension
+    /// `ε_f = D₁ + D₂ exp(D₃/3)`, at the reference rate and room
+    /// temperature (rate and temperature factors 1), where `σ₁ = σ̄`.
+    pub fn tension_fracture_work(&self) -> Real {
+        let dc = &self.damage;
+        let eps_f = dc.d1 + dc.d2 * (dc.d3 / 3.0).exp();
+        let n = self.hardening_exponent;
+        self.yield_stress * eps_f + self.hardening_modulus * eps_f.powf(n + 1.0) / (n + 1.0)
+    }
+
+    /// The damage a plastic increment `d_eps` adds at stress `tau` (von
+    /// Mises value `tau_bar`, rate `rate`, temperature `temperature`): the
+    /// Johnson–Cook `Δε̄/ε_f(σ*)` with `σ* = tr τ/(3 τ̄)` ([RL10, Eq. (5.2)],
+    /// SPEC §6), or, where the locus is Cockcroft–Latham's (Deviation 15),
+    /// `⟨σ₁⟩ Δε̄ / W_c` with `σ₁` the largest principal value of `tau`.
+    pub fn damage_increment(&self, tau: &Tensor3, tau_bar: Real, d_eps: Real, rate: Real, temperature: Real) -> Real {
+        match self.damage.cockcroft_latham {
+            Some(w) => largest_principal(tau).max(0.0) * d_eps / w,
+            None => d_eps / self.failure_strain(mean_stress(tau) / tau_bar, rate, temperature),
+        }
+    }
+
     /// Elastic part of the objective rate, `C : d = K tr(d) I + 2G d′`.
     pub fn elastic_stress_rate(&self, d: &Tensor3) -> Tensor3 {
         identity() * (self.bulk_modulus() * d.trace()) + deviator(d) * (2.0 * self.shear_modulus())
@@ -831,8 +902,7 @@ impl JohnsonCook {
         // below 1e-14).
         let rate = if tau_bar > 0.0 { rate } else { 0.0 };
         let damage = if dt * rate > 1e-18 {
-            let eps_f = self.failure_strain(mean_stress(&trial) / tau_bar, rate, old.temperature);
-            old.damage + dt * rate / eps_f
+            old.damage + self.damage_increment(&trial, tau_bar, dt * rate, rate, old.temperature)
         } else {
             old.damage
         };
@@ -894,14 +964,13 @@ impl JohnsonCook {
         if von_mises(&tau) > self.max_overstress_ratio() * fs.g {
             return self.radial_return(old, &elastic, w, dt, fs);
         }
-        let triaxiality = mean_stress(&old.tau) / tau_bar;
-        let eps_f = self.failure_strain(triaxiality, rate, old.temperature);
+        let damage = self.damage_increment(&old.tau, tau_bar, dt * rate, rate, old.temperature);
         PointState {
             tau,
             eps_p: old.eps_p + dt * rate,
             eps_p_rate: rate,
             temperature: old.temperature + dt * temp_rate,
-            damage: old.damage + dt * rate / eps_f,
+            damage: old.damage + damage,
         }
     }
 
@@ -974,15 +1043,20 @@ impl JohnsonCook {
         let d_temp = self.heating_coefficient() * 0.5 * (tau_bar + tau_end) * d_eps;
         let mean = mean_stress(&trial) - 3.0 * self.bulk_modulus() * self.thermal_expansion * d_temp;
         let rate = d_eps / dt;
-        // End-of-step triaxiality, as befits backward Euler (and defined even
-        // from a zero deviator, where the start-of-step one is 0/0).
-        let triaxiality = mean / tau_end;
+        // End-of-step stress state, as befits backward Euler (and defined
+        // even from a zero deviator, where the start-of-step one is 0/0).
+        let tau = s_trial * (tau_end / tau_trial) + identity() * mean;
+        let damage = match self.damage.cockcroft_latham {
+            Some(_) => self.damage_increment(&tau, tau_end, d_eps, rate, old.temperature),
+            // `mean`, not `tr τ/3` of the rebuilt tensor: the bits of before.
+            None => d_eps / self.failure_strain(mean / tau_end, rate, old.temperature),
+        };
         PointState {
-            tau: s_trial * (tau_end / tau_trial) + identity() * mean,
+            tau,
             eps_p: old.eps_p + d_eps,
             eps_p_rate: rate,
             temperature: old.temperature + d_temp,
-            damage: old.damage + d_eps / self.failure_strain(triaxiality, rate, old.temperature),
+            damage: old.damage + damage,
         }
     }
 
@@ -1670,6 +1744,19 @@ mod tests {
             assert_eq!(names.is_empty(), ok, "cut-off {cut}: {names:?}");
             assert!(ok || names == ["damage.cutoff_triaxiality"]);
         }
+        // Cockcroft–Latham's work: positive and finite, and not with a
+        // cut-off (its ⟨σ₁⟩ is one).
+        let mut w = weldox_460e();
+        for (wc, ok) in [(1.7e9, true), (0.0, false), (-1.0, false), (Real::INFINITY, false), (Real::NAN, false)] {
+            w.damage.cockcroft_latham = Some(wc);
+            let names: Vec<&str> = w.validate().err().unwrap_or_default().iter().map(|e| e.parameter).collect();
+            assert_eq!(names.is_empty(), ok, "W_c {wc}: {names:?}");
+            assert!(ok || names == ["damage.cockcroft_latham"]);
+        }
+        w.damage.cockcroft_latham = Some(1.7e9);
+        w.damage.cutoff_triaxiality = Some(-1.0 / 3.0);
+        let names: Vec<&str> = w.validate().unwrap_err().iter().map(|e| e.parameter).collect();
+        assert_eq!(names, ["damage.cutoff_triaxiality"]);
     }
 
     #[test]

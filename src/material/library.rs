@@ -16,6 +16,7 @@ pub const NAMES: &[&str] = &[
     "weldox_460e_borvik",
     "weldox_460e_borvik_coupled",
     "weldox_460e_cutoff",
+    "weldox_460e_cockcroft_latham",
     "ofhc_copper",
     "steel_4340",
     "steel_42crmo4",
@@ -28,6 +29,7 @@ pub fn builtin(name: &str) -> Option<Material> {
         "weldox_460e_borvik" => Some(Material::JohnsonCook(weldox_460e_borvik())),
         "weldox_460e_borvik_coupled" => Some(Material::JohnsonCook(weldox_460e_borvik_coupled())),
         "weldox_460e_cutoff" => Some(Material::JohnsonCook(weldox_460e_cutoff())),
+        "weldox_460e_cockcroft_latham" => Some(Material::JohnsonCook(weldox_460e_cockcroft_latham())),
         "ofhc_copper" => Some(Material::JohnsonCook(ofhc_copper())),
         "steel_4340" => Some(Material::JohnsonCook(steel_4340())),
         "steel_42crmo4" => Some(Material::JohnsonCook(steel_42crmo4())),
@@ -62,7 +64,15 @@ pub fn weldox_460e() -> JohnsonCook {
         taylor_quinney: 0.9,
         thermal_expansion: 11.2e-6,
         conductivity: 50.0,
-        damage: DamageConstants { d1: 0.0705, d2: 1.732, d3: -0.54, d4: -0.015, d5: 0.0, cutoff_triaxiality: None },
+        damage: DamageConstants {
+            d1: 0.0705,
+            d2: 1.732,
+            d3: -0.54,
+            d4: -0.015,
+            d5: 0.0,
+            cutoff_triaxiality: None,
+            cockcroft_latham: None,
+        },
         damage_coupling: 0.0,
         damage_equivalent_strain: false,
         theta: JohnsonCook::DEFAULT_THETA,
@@ -126,12 +136,31 @@ pub fn weldox_460e_cutoff() -> JohnsonCook {
     m
 }
 
+/// \[RL10\]'s Weldox 460 E ([`weldox_460e`]) with Cockcroft and Latham's
+/// damage (`johnson_cook` Deviation 15): `dD = ⟨σ₁⟩ dε̄ / W_c`, with `W_c`
+/// the work of \[RL10\]'s hardening curve to \[RL10\]'s Johnson–Cook
+/// fracture strain in uniaxial tension
+/// ([`JohnsonCook::tension_fracture_work`], 1.70 GPa), so that the two
+/// loci agree in a tension test. Everything else is [`weldox_460e`]'s.
+pub fn weldox_460e_cockcroft_latham() -> JohnsonCook {
+    let mut m = weldox_460e();
+    m.damage.cockcroft_latham = Some(m.tension_fracture_work());
+    m
+}
+
 /// Damage constants of a metal whose Johnson–Cook failure constants the
 /// source does not give: `D₁ = 10³⁰`, the others 0, so the failure strain is
 /// 10³⁰ and the damage stays at 0 (it is only an output here: the Taylor
 /// cases grow no cracks). Not a fit of anything.
-pub const NO_DAMAGE: DamageConstants =
-    DamageConstants { d1: 1.0e30, d2: 0.0, d3: 0.0, d4: 0.0, d5: 0.0, cutoff_triaxiality: None };
+pub const NO_DAMAGE: DamageConstants = DamageConstants {
+    d1: 1.0e30,
+    d2: 0.0,
+    d3: 0.0,
+    d4: 0.0,
+    d5: 0.0,
+    cutoff_triaxiality: None,
+    cockcroft_latham: None,
+};
 
 /// OFHC copper, Johnson & Cook's 1983 set (the material of their cylinder
 /// impact tests, the Taylor cases `taylor-cu-*`).
