@@ -379,6 +379,7 @@ pub(crate) fn bit_test_entries(mut seed: u64, scale: Real) -> impl FnMut() -> Re
 
 #[cfg(test)]
 mod tests {
+    use super::*;
 
     #[test]
     fn largest_principal_matches_the_symmetric_eigenvalues() {
@@ -410,7 +411,6 @@ mod tests {
         rotated = sym(&rotated);
         assert!((largest_principal(&rotated) - 3.0).abs() < 1e-12);
     }
-    use super::*;
 
     #[test]
     fn von_mises_of_uniaxial_stress_is_the_stress() {

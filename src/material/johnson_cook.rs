@@ -475,7 +475,7 @@ impl JohnsonCook {
             }
         }
         if let Some(w) = dc.cockcroft_latham {
-            check("damage.cockcroft_latham", w, w > 0.0 && w.is_finite(), "> 0 (Pa)");
+            check("damage.cockcroft_latham", w, w > 0.0, "> 0 (Pa)");
         }
         let d_c = self.damage_coupling;
         check("damage_coupling", d_c, (0.0..=1.0).contains(&d_c), "in [0, 1] (Børvik's critical damage D_C)");
@@ -727,15 +727,25 @@ impl JohnsonCook {
         self.yield_stress * eps_f + self.hardening_modulus * eps_f.powf(n + 1.0) / (n + 1.0)
     }
 
-    /// The damage a plastic increment `d_eps` adds at stress `tau` (von
-    /// Mises value `tau_bar`, rate `rate`, temperature `temperature`): the
-    /// Johnson–Cook `Δε̄/ε_f(σ*)` with `σ* = tr τ/(3 τ̄)` ([RL10, Eq. (5.2)],
-    /// SPEC §6), or, where the locus is Cockcroft–Latham's (Deviation 15),
-    /// `⟨σ₁⟩ Δε̄ / W_c` with `σ₁` the largest principal value of `tau`.
-    pub fn damage_increment(&self, tau: &Tensor3, tau_bar: Real, d_eps: Real, rate: Real, temperature: Real) -> Real {
+    /// The damage a plastic increment `d_eps` adds at stress `tau` (mean
+    /// value `mean`, von Mises value `tau_bar`, rate `rate`, temperature
+    /// `temperature`): the Johnson–Cook `Δε̄/ε_f(σ*)` with `σ* = mean/τ̄`
+    /// ([RL10, Eq. (5.2)], SPEC §6), or, where the locus is
+    /// Cockcroft–Latham's (Deviation 15), `⟨σ₁⟩ Δε̄ / W_c` with `σ₁` the
+    /// largest principal value of `tau`. The caller passes `mean` as its
+    /// update formed it (the radial return's before it rebuilds `tau`).
+    pub fn damage_increment(
+        &self,
+        tau: &Tensor3,
+        mean: Real,
+        tau_bar: Real,
+        d_eps: Real,
+        rate: Real,
+        temperature: Real,
+    ) -> Real {
         match self.damage.cockcroft_latham {
             Some(w) => largest_principal(tau).max(0.0) * d_eps / w,
-            None => d_eps / self.failure_strain(mean_stress(tau) / tau_bar, rate, temperature),
+            None => d_eps / self.failure_strain(mean / tau_bar, rate, temperature),
         }
     }
 
@@ -902,7 +912,7 @@ impl JohnsonCook {
         // below 1e-14).
         let rate = if tau_bar > 0.0 { rate } else { 0.0 };
         let damage = if dt * rate > 1e-18 {
-            old.damage + self.damage_increment(&trial, tau_bar, dt * rate, rate, old.temperature)
+            old.damage + self.damage_increment(&trial, mean_stress(&trial), tau_bar, dt * rate, rate, old.temperature)
         } else {
             old.damage
         };
@@ -964,7 +974,7 @@ impl JohnsonCook {
         if von_mises(&tau) > self.max_overstress_ratio() * fs.g {
             return self.radial_return(old, &elastic, w, dt, fs);
         }
-        let damage = self.damage_increment(&old.tau, tau_bar, dt * rate, rate, old.temperature);
+        let damage = self.damage_increment(&old.tau, mean_stress(&old.tau), tau_bar, dt * rate, rate, old.temperature);
         PointState {
             tau,
             eps_p: old.eps_p + dt * rate,
@@ -1046,11 +1056,7 @@ impl JohnsonCook {
         // End-of-step stress state, as befits backward Euler (and defined
         // even from a zero deviator, where the start-of-step one is 0/0).
         let tau = s_trial * (tau_end / tau_trial) + identity() * mean;
-        let damage = match self.damage.cockcroft_latham {
-            Some(_) => self.damage_increment(&tau, tau_end, d_eps, rate, old.temperature),
-            // `mean`, not `tr τ/3` of the rebuilt tensor: the bits of before.
-            None => d_eps / self.failure_strain(mean / tau_end, rate, old.temperature),
-        };
+        let damage = self.damage_increment(&tau, mean, tau_end, d_eps, rate, old.temperature);
         PointState {
             tau,
             eps_p: old.eps_p + d_eps,
