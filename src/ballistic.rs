@@ -217,19 +217,26 @@ impl Projectile {
     }
 
     /// Set its initial velocity in `case` to `v` (m/s); what a run's
-    /// provenance records of it.
+    /// provenance records of it: a `--set` override that gives the same
+    /// change (`plugsim run --set` with a run's recorded overrides
+    /// reruns it).
     fn set_velocity(self, case: &mut Case, v: [Real; 2]) -> String {
         match self {
             Projectile::Rigid(k) => {
-                case.rigid_bodies[k].velocity = v;
-                format!("rigid_bodies[{k}].velocity = {v:?}")
+                let body = &mut case.rigid_bodies[k];
+                body.velocity = v;
+                format!("rigid_bodies.{}.velocity={v:?}", body.name)
             }
             Projectile::Deformable(b) => {
+                // its whole-body entry (one without a region; the last, as
+                // `whole_body_velocity` reads it): a deformable projectile has one
                 let body = &mut case.bodies[b];
-                if let Some(velocity) = body.whole_body_velocity_mut() {
-                    *velocity = v;
+                let j = body.initial_velocity.iter().rposition(|iv| iv.region.is_none());
+                if let Some(j) = j {
+                    body.initial_velocity[j].velocity = v;
                 }
-                format!("bodies.{}.initial_velocity (whole body) = {v:?}", body.name)
+                let j = j.map_or_else(|| "(none)".to_string(), |j| j.to_string());
+                format!("bodies.{}.initial_velocity.{j}.velocity={v:?}", body.name)
             }
         }
     }
@@ -515,7 +522,10 @@ pub fn at_speed(case: &Case, projectile: Projectile, speed: Real, max_time: Real
     let mut c = case.clone();
     let (dir, _) = flight(case, projectile);
     let mut set = vec![projectile.set_velocity(&mut c, [dir.x * speed, dir.y * speed])];
-    c.time.stop_after_release.get_or_insert(STOP_AFTER);
+    if c.time.stop_after_release.is_none() {
+        c.time.stop_after_release = Some(STOP_AFTER);
+        set.push(format!("time.stop_after_release={STOP_AFTER:e}"));
+    }
     if max_time > c.time.end {
         c.time.end = max_time;
         set.push(format!("time.end={max_time:e}"));
