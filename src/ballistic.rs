@@ -67,6 +67,12 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
 
+/// The speed, in impact speeds, that the impact's waves give a particle
+/// at most: a free face doubles the particle velocity of the wave that
+/// meets it. The report names every run whose fastest particle went
+/// faster ([`outran_doubling`]).
+pub const FREE_SURFACE_DOUBLING: Real = 2.0;
+
 /// `time.stop_after_release` of every run, s, unless the case sets one:
 /// long enough for a plug thrown ahead to be caught again (as
 /// [`crate::validation::RELEASE_WAIT`]).
@@ -576,6 +582,11 @@ pub struct Shot {
     /// Particles detached from their body (0 without it, `fracture.detach_below`).
     #[serde(default)]
     pub detached: usize,
+    /// The fastest particle: which, where from, its mass, when and whether
+    /// it lay on a crack face (`None` in a run finished by a build that did
+    /// not record it).
+    #[serde(default)]
+    pub fastest_particle: Option<crate::step::FastestParticle>,
 }
 
 impl Shot {
@@ -987,6 +998,7 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
                 floor_eroded: s.floor_eroded.unwrap_or(0),
                 axis_energy: s.axis_energy,
                 detached: s.detached.len(),
+                fastest_particle: Some(s.fastest),
             };
             let kept = FinishedRun { writer: crate::checkpoint::this_writer(), shot: shot.clone() };
             // Not written (a full disk): `--resume` runs it again; the table has it.
@@ -1299,8 +1311,36 @@ pub fn report(header: &str, study: &Study) -> String {
             most.axis_energy, most.speed
         ));
     }
+    if let Some(note) = outran_doubling(&study.shots) {
+        s.push_str(&note);
+    }
     s.push_str(&format!("{DEFINITIONS}\n\n![v_r against v_i](ballistic.png)\n"));
     s
+}
+
+/// The report's note on the runs whose fastest particle outran
+/// [`FREE_SURFACE_DOUBLING`] times the impact speed (issue #19 item 5: a
+/// particle faster than that was thrown by something other than the
+/// impact's waves; docs/validation.md, "Fastest particle"), naming each
+/// particle; `None` where no run's did.
+pub fn outran_doubling(shots: &[Shot]) -> Option<String> {
+    let fast: Vec<String> = shots
+        .iter()
+        .filter(|x| x.fastest > FREE_SURFACE_DOUBLING * x.speed)
+        .map(|x| {
+            let who = x.fastest_particle.map_or_else(|| format!("{:.1} m/s", x.fastest), |f| f.describe());
+            format!("- at {:.2} m/s ({:.2} v_i): {who}\n", x.speed, x.fastest / x.speed)
+        })
+        .collect();
+    (!fast.is_empty()).then(|| {
+        format!(
+            "Particles faster than the free-surface doubling 2 v_i (an elastic wave at a free face doubles the \
+             particle speed, so a particle past it was thrown by something else: a crack-face particle squeezed \
+             out, a light particle ringing under a contact; docs/validation.md, \"Fastest particle\"; each run's \
+             `history.csv` has `max_particle_speed`):\n\n{}\n",
+            fast.concat()
+        )
+    })
 }
 
 /// The run with the largest positive `value` (the last of equal ones), for
@@ -1786,8 +1826,51 @@ mod tests {
             floor_eroded: 0,
             axis_energy: 0.0,
             detached: 0,
+            fastest_particle: None,
             dir: PathBuf::new(),
         }
+    }
+
+    /// The report names each run whose fastest particle outran `2 v_i`,
+    /// and only those; a run's [`SHOT_FILE`] keeps its fastest particle
+    /// across `--resume`, and one written before it was recorded still reads.
+    #[test]
+    fn runs_past_the_free_surface_doubling_are_named() {
+        let held = Verdict::Held { since: 0.0 };
+        let thrown = crate::step::FastestParticle {
+            speed: 441.2,
+            particle: 40608,
+            time: 15.85e-6,
+            position: Vec2::new(10.01e-3, 10.25e-3),
+            reference: Vec2::new(9.7e-3, 12e-3),
+            mass: 9.326e-6,
+            crack_face: true,
+        };
+        let mut fast = shot(180.0, held);
+        (fast.fastest, fast.fastest_particle) = (441.2, Some(thrown));
+        let mut slow = shot(190.0, Verdict::Perforated { residual: 74.0, since: 0.0 });
+        slow.fastest = 313.0;
+        assert_eq!(outran_doubling(&[slow.clone()]), None);
+        let note = outran_doubling(&[fast.clone(), slow.clone()]).unwrap();
+        assert!(
+            note.contains("- at 180.00 m/s (2.45 v_i): 441.2 m/s, particle 40608 (a crack-face particle"),
+            "{note}"
+        );
+        assert!(!note.contains("190.00"), "{note}");
+        // a run taken back from a file without the particle: its speed only
+        let mut old = fast.clone();
+        old.fastest_particle = None;
+        assert!(outran_doubling(&[old]).unwrap().contains("- at 180.00 m/s (2.45 v_i): 441.2 m/s\n"));
+        let study = Study { shots: vec![fast.clone(), slow], ..Study::default() };
+        assert!(report("header", &study).contains(&note));
+        // the shot file keeps it, and an older one without it reads
+        let text = toml::to_string(&FinishedRun { writer: "w".into(), shot: fast.clone() }).unwrap();
+        let back: FinishedRun = toml::from_str(&text).unwrap();
+        assert_eq!(back.shot, fast);
+        let older = text.lines().take_while(|l| !l.contains("fastest_particle")).collect::<Vec<_>>().join("\n");
+        let back: FinishedRun = toml::from_str(&older).unwrap();
+        assert_eq!(back.shot.fastest_particle, None);
+        assert_eq!(back.shot.fastest, 441.2);
     }
 
     #[test]
