@@ -234,12 +234,11 @@ impl Projectile {
                 format!("rigid_bodies.{}.velocity={v:?}", body.name)
             }
             Projectile::Deformable(b) => {
-                // its whole-body entry (one without a region; the last, as
-                // `whole_body_velocity` reads it): a deformable projectile has one
+                // a deformable projectile flies as a whole: it has that entry
                 let body = &mut case.bodies[b];
-                let j = body.initial_velocity.iter().rposition(|iv| iv.region.is_none());
-                if let Some(j) = j {
-                    body.initial_velocity[j].velocity = v;
+                let j = body.whole_body_entry();
+                if let Some(velocity) = body.whole_body_velocity_mut() {
+                    *velocity = v;
                 }
                 let j = j.map_or_else(|| "(none)".to_string(), |j| j.to_string());
                 format!("bodies.{}.initial_velocity.{j}.velocity={v:?}", body.name)

@@ -125,12 +125,19 @@ impl BodySpec {
     /// The velocity given over the whole body (the last `initial_velocity`
     /// entry without a region), m/s: a deformable projectile's flight.
     pub fn whole_body_velocity(&self) -> Option<[Real; 2]> {
-        self.initial_velocity.iter().rev().find(|iv| iv.region.is_none()).map(|iv| iv.velocity)
+        self.whole_body_entry().map(|j| self.initial_velocity[j].velocity)
     }
 
     /// [`Self::whole_body_velocity`], to change it.
     pub fn whole_body_velocity_mut(&mut self) -> Option<&mut [Real; 2]> {
-        self.initial_velocity.iter_mut().rev().find(|iv| iv.region.is_none()).map(|iv| &mut iv.velocity)
+        self.whole_body_entry().map(|j| &mut self.initial_velocity[j].velocity)
+    }
+
+    /// The index in `initial_velocity` of the entry that gives the whole
+    /// body's velocity ([`Self::whole_body_velocity`]): what a `--set`
+    /// override names to change it (`bodies.NAME.initial_velocity.J.velocity`).
+    pub fn whole_body_entry(&self) -> Option<usize> {
+        self.initial_velocity.iter().rposition(|iv| iv.region.is_none())
     }
 }
 
