@@ -80,10 +80,40 @@
 //!   [`Spreading::ShapeFunction`], whose gap point is
 //!   `x(X_s) = X_s + Σ_J N_J(X_s) U_J` and whose force `f_J = N_J F` moves
 //!   that point by `Δt² F / m_eff` (for a top-row particle of a uniform
-//!   lattice `m_eff = 2 m_s`: with `m_s` only half the penetration would go).
+//!   lattice `m_eff = 2 m_s`: with `m_s` only half the penetration would go);
+//!   `(Σ_J w_J² / m_J)⁻¹ = (Σ m_J N_J)² / Σ m_J N_J²` for
+//!   [`Spreading::MassWeighted`].
 //!   Where several slaves share particles the forces are solved together
 //!   (`ContactSystem::compute_forces`). Test:
 //!   `shape_function_contact_of_an_isolated_point_is_exact`.
+//! - **Mass-weighted spreading (an option, issue #19 item 5).**
+//!   [`Spreading::MassWeighted`] measures the gap at `X_s + Σ_J w_J U_J`
+//!   and spreads `f_J = w_J F` with `w_J = m_J N_J(X_s) / Σ_K m_K N_K(X_s)`
+//!   ([`mass_weights`]): the row's local centre of mass instead of the
+//!   physical point. It is a consistent pair (the force's virtual work is
+//!   `F·δ(Σ w_J U_J)`, exactly the variation of the gap), so like the
+//!   shape-function mode it conserves force and momentum and its one-step
+//!   force can only dissipate; it equals the shape-function mode where the
+//!   row's masses are equal (plane strain on a uniform lattice). Why: with
+//!   `f_J = N_J F` a light particle in a slave's row (a crack's split
+//!   child, the axis ring of an axisymmetric model) is accelerated by
+//!   `N_J F / m_J`, five to ten times its neighbours, and a torn child
+//!   whose material no longer holds it was pushed down the side wall at
+//!   2.45 `v_i` (docs/validation.md, "Three more throws traced");
+//!   mass-weighted, every particle of the row takes `N_J F / Σ m_K N_K`.
+//!   An earlier try spread by mass but measured the gap at the physical
+//!   point: not a consistent pair, it put 7.8 J in. What it costs: the gap
+//!   point is not the physical surface where masses differ (it lies
+//!   toward the heavier particles' displacements; the offset is a
+//!   fraction of a spacing at the axis, zero on a uniform plane lattice),
+//!   and a light particle that its material still holds is no longer held
+//!   by the contact itself, so it swings with its material instead (the
+//!   axis ring under a rounded nose still rings). Deformable pairs keep
+//!   the shape-function points. Not the default (measured in
+//!   docs/validation.md, "The mass-weighted contact spreading"). Tests:
+//!   `mass_weighted_contact_of_an_isolated_point_is_exact`,
+//!   `mass_weighted_spreading_holds_the_rows_centre_of_mass_not_a_light_particle`,
+//!   `momentum_and_energy_with_a_free_body`.
 //! - **Inverse-distance weights.** `w_J ∝ 1 / max(|X_J − X_s|, ρ h_s)`
 //!   (reference distances, `ρ` = `inverse_distance_floor`, default ½), over
 //!   the particles of the slave's shape-function row that lie in the slave's
@@ -113,6 +143,30 @@ pub enum Spreading {
     /// virtual work of a point force). Default: see the `contact` module doc.
     #[default]
     ShapeFunction,
+    /// Variationally consistent over the row's mass: gap at
+    /// `X_s + Σ_J w_J U_J`, force `f_J = w_J F`, with the weights
+    /// `w_J = m_J N_J(X_s) / Σ_K m_K N_K(X_s)` ([`mass_weights`]). Every
+    /// particle of the row is accelerated by `N_J F / Σ_K m_K N_K`, in
+    /// proportion to its shape function whatever its mass; identical to
+    /// [`Spreading::ShapeFunction`] where the row's masses are equal. An
+    /// option (issue #19 item 5): module doc, # Deviations.
+    MassWeighted,
+}
+
+/// The mass-weighted row of [`Spreading::MassWeighted`]: for the entries
+/// `(J, N_J)` of a shape-function row and the particles' masses, the
+/// entries `(J, m_J N_J / Σ_K m_K N_K)` in row order, which sum to 1. `Err`
+/// with the sum `Σ_K m_K N_K` when it is not positive and finite: the row
+/// then has no mass-weighted point.
+pub fn mass_weights<'a, I>(row: I, mass: &'a [Real]) -> Result<impl Iterator<Item = (u32, Real)> + 'a, Real>
+where
+    I: Iterator<Item = (u32, Real)> + Clone + 'a,
+{
+    let total: Real = row.clone().map(|(j, n)| mass[j as usize] * n).sum();
+    if !(total.is_finite() && total > 0.0) {
+        return Err(total);
+    }
+    Ok(row.map(move |(j, n)| (j, mass[j as usize] * n / total)))
 }
 
 /// Normal force along `n_m` that removes the gap `g` of a point of effective

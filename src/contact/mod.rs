@@ -51,6 +51,8 @@
 //! and low contact dissipation (1.5 % of the contact work, against 11 %) of
 //! the point contact. Provisional: one geometry, elastic, 50–120 steps; to
 //! be confirmed on the plugging case itself (residual velocity per mode).
+//! [`Spreading::MassWeighted`] (an option) holds the row's local centre of
+//! mass instead of the physical point ([`force`], # Deviations).
 //!
 //! # Deviations (details and tests in the submodules)
 //! - One-step force with factor 1, not the 2 of [RL10, §3], for SPEC §5's half-step

@@ -16,7 +16,9 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::deformable::{DeformableMasters, SegmentContact};
-use super::force::{coulomb_cap, gap_floor, inverse_distance_weights, one_step_normal_force, stick_force, Spreading};
+use super::force::{
+    coulomb_cap, gap_floor, inverse_distance_weights, mass_weights, one_step_normal_force, stick_force, Spreading,
+};
 use super::rigid::RigidBody;
 use super::search::{check_pairing, search_rigid_polygon, Projection};
 use super::slave::{Pairing, SlaveSet};
@@ -149,7 +151,7 @@ pub struct StepInput<'a> {
     /// Body of each particle (deformable masters).
     pub body: &'a [u32],
     /// Shape functions at the particles, `N_J(X_I)` in row `I`; needed by
-    /// [`Spreading::InverseDistance`] and [`Spreading::ShapeFunction`].
+    /// every spreading but [`Spreading::None`].
     pub shape: Option<&'a ShapeTable>,
     /// Time step `Δt = Δt_{n+½}`, s: the displacement step.
     pub dt: Real,
@@ -252,7 +254,8 @@ pub struct ActiveContact {
     /// Outward master normal `n_m`.
     pub normal: Vec2,
     /// Effective mass of the gap point for its own normal force, kg
-    /// (`m_s`, `m_s / w_ss` or `(Σ N_J²/m_J)⁻¹` by spreading mode).
+    /// (`m_s`, `m_s / w_ss`, `(Σ N_J²/m_J)⁻¹` or `(Σ w_J²/m_J)⁻¹` by
+    /// spreading mode).
     pub effective_mass: Real,
     /// Normal force magnitude `f_n`, N.
     pub normal_force: Real,
@@ -713,15 +716,12 @@ impl ContactSystem {
                     Some(rows) => rows,
                     None => {
                         let start = self.gap_w.len();
-                        match spreading {
-                            Spreading::None | Spreading::InverseDistance => self.gap_w.push((s as u32, 1.0)),
-                            Spreading::ShapeFunction => shape_row(input, s, &mut self.gap_w)?,
-                        }
+                        gap_row(input, s, spreading, &mut self.gap_w)?;
                         *gap_rows.insert((start as u32, self.gap_w.len() as u32))
                     }
                 };
                 let force_rows = match spreading {
-                    Spreading::None | Spreading::ShapeFunction => gap_rows,
+                    Spreading::None | Spreading::ShapeFunction | Spreading::MassWeighted => gap_rows,
                     Spreading::InverseDistance => {
                         let start = self.force_w.len();
                         inverse_distance_neighbours(input, s, self.params.inverse_distance_floor, &mut self.force_w)?;
@@ -732,7 +732,7 @@ impl ContactSystem {
                 let rows = |r: (u32, u32)| r.0 as usize..r.1 as usize;
                 let force_w = match spreading {
                     Spreading::InverseDistance => &self.force_w[rows(force_rows)],
-                    Spreading::None | Spreading::ShapeFunction => &self.gap_w[rows(gap_rows)],
+                    Spreading::None | Spreading::ShapeFunction | Spreading::MassWeighted => &self.gap_w[rows(gap_rows)],
                 };
                 let (c_n, c_t) = row_compliance(input, &self.gap_w[rows(gap_rows)], force_w, &normal, &tangent);
                 let relative = vel - body.predicted_velocity();
@@ -894,10 +894,7 @@ impl ContactSystem {
         let normal = Vec2::new(1.0, 0.0);
         for (i, g) in near {
             let start = self.gap_w.len() as u32;
-            match spreading {
-                Spreading::None | Spreading::InverseDistance => self.gap_w.push((i as u32, 1.0)),
-                Spreading::ShapeFunction => shape_row(input, i, &mut self.gap_w)?,
-            }
+            gap_row(input, i, spreading, &mut self.gap_w)?;
             let gap_rows = (start, self.gap_w.len() as u32);
             // Inverse-distance spreading reads the forces' rows from
             // `force_w`: the axis spreads its force as the gap point reads.
@@ -1093,12 +1090,34 @@ fn effective_mass(compliance: Real) -> Real {
     }
 }
 
-/// Row `s` of the particle shape table as (particle, N) pairs, with its
-/// partition of unity checked.
-fn shape_row(input: &StepInput, s: usize, out: &mut Vec<(u32, Real)>) -> Result<(), ContactError> {
-    let table = checked_shape_row(input, s)?;
-    out.extend(table.range(s).map(|e| (table.index[e], table.value[e])));
+/// The (particle, weight) row of slave `s`'s gap point, appended to `out`:
+/// the slave alone, its shape-function row `N_J(X_s)` (partition of unity
+/// checked) or that row weighted by mass ([`mass_weights`]), by
+/// `spreading`. The weights sum to 1.
+fn gap_row(input: &StepInput, s: usize, spreading: Spreading, out: &mut Vec<(u32, Real)>) -> Result<(), ContactError> {
+    match spreading {
+        Spreading::None | Spreading::InverseDistance => out.push((s as u32, 1.0)),
+        Spreading::ShapeFunction => {
+            let table = checked_shape_row(input, s)?;
+            out.extend(table.range(s).map(|e| (table.index[e], table.value[e])));
+        }
+        Spreading::MassWeighted => out.extend(mass_weighted_row(input, s)?),
+    }
     Ok(())
+}
+
+/// Slave `s`'s shape-function row weighted by mass ([`mass_weights`]).
+fn mass_weighted_row<'a>(
+    input: &StepInput<'a>,
+    s: usize,
+) -> Result<impl Iterator<Item = (u32, Real)> + 'a, ContactError> {
+    let table = checked_shape_row(input, s)?;
+    let row = table.range(s).map(move |e| (table.index[e], table.value[e]));
+    mass_weights(row, input.mass).map_err(|sum| ContactError::InvalidParticle {
+        particle: s,
+        field: "mass-weighted row sum",
+        value: sum,
+    })
 }
 
 /// The particle shape table, once row `s` is checked: indices in range and
@@ -1142,6 +1161,11 @@ pub(super) fn predict_gap_point(input: &StepInput, s: usize, spreading: Spreadin
             let table = checked_shape_row(input, s)?;
             for e in table.range(s) {
                 add(table.index[e] as usize, table.value[e])?;
+            }
+        }
+        Spreading::MassWeighted => {
+            for (j, w) in mass_weighted_row(input, s)? {
+                add(j as usize, w)?;
             }
         }
     }
