@@ -109,7 +109,10 @@
 //!   and a light particle that its material still holds is no longer held
 //!   by the contact itself, so it swings with its material instead (the
 //!   axis ring under a rounded nose still rings). Deformable pairs keep
-//!   the shape-function points. Not the default (measured in
+//!   the shape-function points; the axis wall (`ContactSystem::with_axis`)
+//!   holds the mass-weighted points like the rigid pairs, so a physical
+//!   point beside the axis may reach `r < 0` by that offset (left so: the
+//!   measured runs have these bits). Not the default (measured in
 //!   docs/validation.md, "The mass-weighted contact spreading"). Tests:
 //!   `mass_weighted_contact_of_an_isolated_point_is_exact`,
 //!   `mass_weighted_spreading_holds_the_rows_centre_of_mass_not_a_light_particle`,
