@@ -1115,7 +1115,7 @@ fn compare_spreading_on_elastic_impact() {
 /// equal masses the two spreadings are the same to round-off. So the
 /// option does not remove the ringing of a light particle that its
 /// material holds (the axis ring under the rounded nose's first contact,
-/// docs/validation.md "The mass-weighted spreading"); it removes the
+/// docs/validation.md "A mass-weighted contact spreading"); it removes the
 /// contact's push on a light particle that its material no longer holds.
 #[test]
 fn mass_weighted_spreading_holds_the_rows_centre_of_mass_not_a_light_particle() {

@@ -113,7 +113,8 @@
 //!   holds the mass-weighted points like the rigid pairs, so a physical
 //!   point beside the axis may reach `r < 0` by that offset (left so: the
 //!   measured runs have these bits). Not the default (measured in
-//!   docs/validation.md, "The mass-weighted contact spreading"). Tests:
+//!   docs/validation.md, "A mass-weighted contact spreading (an option), and the
+//!   hemispherical nose's km/s throw traced"). Tests:
 //!   `mass_weighted_contact_of_an_isolated_point_is_exact`,
 //!   `mass_weighted_spreading_holds_the_rows_centre_of_mass_not_a_light_particle`,
 //!   `momentum_and_energy_with_a_free_body`.
