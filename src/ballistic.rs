@@ -1117,8 +1117,15 @@ pub fn refit(study: &mut Study) {
 /// Experimental points `(v_i, v_r)` from a CSV file with header `v_i,v_r`
 /// (m/s; `#` starts a comment; `v_r = 0`: the plate held).
 pub fn read_experiments(path: &Path) -> Result<Vec<(Real, Real)>, BallisticError> {
-    let err = |message: String| BallisticError::Experiments { path: path.display().to_string(), message };
-    let text = std::fs::read_to_string(path).map_err(|e| err(e.to_string()))?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| BallisticError::Experiments { path: path.display().to_string(), message: e.to_string() })?;
+    parse_experiments(&text, &path.display().to_string())
+}
+
+/// [`read_experiments`]'s reading of the CSV `text`; `source` names it in
+/// an error.
+pub fn parse_experiments(text: &str, source: &str) -> Result<Vec<(Real, Real)>, BallisticError> {
+    let err = |message: String| BallisticError::Experiments { path: source.to_string(), message };
     let mut lines = text
         .lines()
         .enumerate()
@@ -1143,6 +1150,47 @@ pub fn read_experiments(path: &Path) -> Result<Vec<(Real, Real)>, BallisticError
             }
         })
         .collect()
+}
+
+/// Why the tests of a built-in case (`reference`, as shipped) do not belong
+/// on the curve of `case` (the same case after `--set`), or `None` where
+/// they do: the target's thickness, and the projectile's shape, size and
+/// mass, must be the tests'. What the overrides may change is the model
+/// (materials, fracture, contact, resolution, numerical parameters) and the
+/// impact speed, which a study sets itself; a plate of another thickness
+/// or another projectile is another experiment, whose tests these are not.
+pub fn tests_differ(reference: &Case, case: &Case) -> Option<String> {
+    let thickness = |c: &Case| target(c).map(|b| c.bodies[b].rectangle.y_max - c.bodies[b].rectangle.y_min);
+    let (t0, t) = (thickness(reference), thickness(case));
+    if let (Some(t0), Some(t)) = (t0, t) {
+        if (t - t0).abs() > 1e-9 * t0 {
+            return Some(format!("the target is {:.3} mm thick, the tests' {:.3} mm", t * 1e3, t0 * 1e3));
+        }
+    } else if t0 != t {
+        return Some("the case has another target".into());
+    }
+    // The projectiles, their initial velocities aside (a study sets them).
+    let still = |c: &Case| {
+        let mut r = c.rigid_bodies.clone();
+        r.iter_mut().for_each(|b| b.velocity = [0.0; 2]);
+        r
+    };
+    if still(reference) != still(case) {
+        return Some("the rigid projectile's shape, size or mass is not the tests'".into());
+    }
+    let flights = |c: &Case| {
+        flying_bodies(c)
+            .into_iter()
+            .map(|b| {
+                let r = &c.bodies[b].rectangle;
+                (r.x_min, r.x_max, r.y_min, r.y_max)
+            })
+            .collect::<Vec<_>>()
+    };
+    if flights(reference) != flights(case) {
+        return Some("the deformable projectile's size is not the tests'".into());
+    }
+    None
 }
 
 /// The table as (Markdown, CSV).

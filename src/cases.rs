@@ -229,6 +229,36 @@ pub const BORVIK_NOSE_CASES: &[&str] = &["borvik-2002-12mm-blunt", "borvik-2002-
 /// [`borvik_family`].
 pub const BORVIK_DEFORMABLE_CASES: &[&str] = &["borvik-1-axisymmetric-deformable", "borvik-2-axisymmetric-deformable"];
 
+/// The tests a built-in case stands for, plotted by `plugsim ballistic` on
+/// its curve: `(case name or name prefix, file, CSV text)`, the file being
+/// the one the text is read from (`cases/reference/`, header `v_i,v_r`).
+/// Every member of Børvik's Case I or II family (any geometry, resolution or
+/// criterion: the same test) carries its test, each nose case its tests.
+/// `tests/reference_cases.rs` checks that every experiments file belongs to
+/// a built-in case and every prefix names one.
+pub const BUILTIN_EXPERIMENTS: &[(&str, &str, &str)] = &[
+    ("borvik-1-", "cases/reference/borvik-case-1.csv", include_str!("../cases/reference/borvik-case-1.csv")),
+    ("borvik-2-", "cases/reference/borvik-case-2.csv", include_str!("../cases/reference/borvik-case-2.csv")),
+    (
+        "borvik-2002-12mm-blunt",
+        "cases/reference/borvik-2002-12mm-blunt.csv",
+        include_str!("../cases/reference/borvik-2002-12mm-blunt.csv"),
+    ),
+    (
+        "borvik-2002-12mm-hemispherical",
+        "cases/reference/borvik-2002-12mm-hemispherical.csv",
+        include_str!("../cases/reference/borvik-2002-12mm-hemispherical.csv"),
+    ),
+];
+
+/// The tests of built-in case `name` (or its alias), `(file, CSV text)`,
+/// where [`BUILTIN_EXPERIMENTS`] has them.
+pub fn builtin_experiments(name: &str) -> Option<(&'static str, &'static str)> {
+    let name = resolve_alias(name);
+    BUILTIN_CASES.iter().find(|c| c.0 == name)?;
+    BUILTIN_EXPERIMENTS.iter().find(|e| name.starts_with(e.0)).map(|e| (e.1, e.2))
+}
+
 /// Short names for the paper's models: `(alias, built-in case)`.
 pub const ALIASES: &[(&str, &str)] = &[("borvik-1", "borvik-1-plane-strain"), ("borvik-2", "borvik-2-plane-strain")];
 
@@ -359,5 +389,25 @@ mod tests {
         assert_eq!(family[9].name(), "borvik-1-axisymmetric-fine-damage-modified");
         assert_eq!(family[11].name(), "borvik-1-axisymmetric-fine-nonlocal");
         assert_eq!(family[23].name(), "borvik-2-axisymmetric-fine-nonlocal");
+    }
+
+    /// Every member of Børvik's family carries its own experiment's test
+    /// (Case I's or II's, whatever the model), each nose case its nose's,
+    /// and the aliases their cases'; the other built-ins carry none.
+    #[test]
+    fn every_borvik_case_carries_its_tests() {
+        for m in borvik_family() {
+            let (file, _) = builtin_experiments(&m.name()).unwrap_or_else(|| panic!("{}", m.name()));
+            assert_eq!(file, format!("cases/reference/borvik-case-{}.csv", m.experiment), "{}", m.name());
+        }
+        for name in BORVIK_NOSE_CASES.iter().chain(BORVIK_DEFORMABLE_CASES) {
+            assert!(builtin_experiments(name).is_some(), "{name}");
+        }
+        let (file, _) = builtin_experiments("borvik-2002-12mm-hemispherical").unwrap();
+        assert_eq!(file, "cases/reference/borvik-2002-12mm-hemispherical.csv");
+        assert_eq!(builtin_experiments("borvik-2"), builtin_experiments("borvik-2-plane-strain"));
+        for name in ["elastic-strike", "two-plates-axisymmetric", "taylor-cu-130", "no-such-case"] {
+            assert_eq!(builtin_experiments(name), None, "{name}");
+        }
     }
 }

@@ -237,8 +237,9 @@ fn dispatch(cmd: Command) -> Result<()> {
     match cmd {
         Command::Cases => list_cases(),
         Command::Ballistic { case_file, case, set, out, args } => {
+            let builtin = case.clone();
             let (case, name, file) = load(&case_file, &case, &set)?;
-            ballistic(case, &name, &file, &set, out, *args)
+            ballistic(case, &name, &file, builtin.as_deref(), &set, out, *args)
         }
         Command::Bench { case, steps, whole, set } => bench(&case, steps, whole, &set),
         Command::Validate { out, all, only, full_time, family, set } => match family.as_str() {
@@ -555,7 +556,9 @@ struct BallisticArgs {
     /// Runs side by side (default: one per core, one thread each).
     #[arg(long)]
     jobs: Option<usize>,
-    /// Experimental points to plot: a CSV with header v_i,v_r (m/s).
+    /// Experimental points to plot: a CSV with header v_i,v_r (m/s). Default: a built-in
+    /// Borvik case's own tests (cases/reference/), unless --set changed its plate's thickness
+    /// or its projectile.
     #[arg(long)]
     experiments: Option<PathBuf>,
     /// Run the whole study at each of these resolutions: particle rows
@@ -623,15 +626,51 @@ fn distinct_phases(given: &[f64]) -> Result<Vec<f64>> {
     Ok(given.to_vec())
 }
 
+/// The experimental points of a study and what they are, for its report.
+struct Tests {
+    points: Vec<(f64, f64)>,
+    /// A clause for the report's header: where the points come from, or
+    /// why a built-in case's tests are not plotted; empty where none.
+    note: String,
+}
+
+/// The tests on a study's plot: `--experiments FILE` where given, else the
+/// built-in case's own (`cases::builtin_experiments`) unless the overrides
+/// made it another experiment (`ballistic::tests_differ`: another plate
+/// thickness or projectile).
+fn study_tests(given: Option<&Path>, builtin: Option<&str>, case: &Case) -> Result<Tests> {
+    use plugsim::ballistic::{parse_experiments, read_experiments, tests_differ};
+    if let Some(path) = given {
+        let points = read_experiments(path)?;
+        let note = format!("; experiments on the plot: {} ({} points)", path.display(), points.len());
+        return Ok(Tests { points, note });
+    }
+    let Some((name, (path, text))) = builtin.and_then(|n| Some((n, plugsim::cases::builtin_experiments(n)?))) else {
+        return Ok(Tests { points: Vec::new(), note: String::new() });
+    };
+    let shipped = Case::from_str_with(builtin_case(name).unwrap_or_default(), &format!("<built-in {name}>"), &[])?;
+    if let Some(why) = tests_differ(&shipped, case) {
+        eprintln!("plugsim ballistic: the built-in case's tests ({path}) are not plotted: {why}");
+        return Ok(Tests {
+            points: Vec::new(),
+            note: format!("; the built-in case's tests ({path}) not plotted: {why}"),
+        });
+    }
+    let points = parse_experiments(text, path)?;
+    let note = format!("; experiments on the plot: the built-in case's tests, {path} ({} points)", points.len());
+    Ok(Tests { points, note })
+}
+
 fn ballistic(
     case: Case,
     name: &str,
     file: &str,
+    builtin: Option<&str>,
     set: &[String],
     out: Option<PathBuf>,
     args: BallisticArgs,
 ) -> Result<()> {
-    use plugsim::ballistic::{at_phase, at_rows, read_experiments, select_projectile, write_ladder_files, Rung};
+    use plugsim::ballistic::{at_phase, at_rows, select_projectile, write_ladder_files, Rung};
     let projectile = select_projectile(&case, file, args.projectile.as_deref())?;
     let speeds = args.speeds();
     if speeds.is_empty() && !args.limit {
@@ -678,15 +717,12 @@ fn ballistic(
             grids.push((rows, None, refined, extra));
         }
     }
-    let experiments = match &args.experiments {
-        Some(p) => read_experiments(p)?,
-        None => Vec::new(),
-    };
+    let tests = study_tests(args.experiments.as_deref(), builtin, &case)?;
     let out_dir = out.unwrap_or_else(|| Path::new("runs").join(format!("ballistic-{name}")));
     let interrupt = install_interrupt_handler();
     let started = Instant::now();
     if grids.is_empty() {
-        let (study, _) = one_study(case, file, set, projectile, &out_dir, &args, &experiments, &interrupt, started)?;
+        let (study, _) = one_study(case, file, set, projectile, &out_dir, &args, &tests, &interrupt, started)?;
         return finish(&study);
     }
     let mut rungs = Vec::new();
@@ -707,7 +743,7 @@ fn ballistic(
             if extra.is_empty() { String::new() } else { format!(": {}", extra.join(" ")) }
         );
         let all: Vec<String> = set.iter().chain(&extra).cloned().collect();
-        let (study, edge) = one_study(refined, file, &all, projectile, &dir, &args, &experiments, &interrupt, started)?;
+        let (study, edge) = one_study(refined, file, &all, projectile, &dir, &args, &tests, &interrupt, started)?;
         let stop = study.interrupted;
         rungs.push(Rung { rows, spacing, overrides: extra, edge, phase, study });
         if stop {
@@ -715,8 +751,9 @@ fn ballistic(
         }
     }
     let header = format!(
-        "Case {file}{}, produced by `plugsim ballistic{}{}` ({} {}) on {}; total wall time {:.0} s{}.",
+        "Case {file}{}{}, produced by `plugsim ballistic{}{}` ({} {}) on {}; total wall time {:.0} s{}.",
         if set.is_empty() { String::new() } else { format!(" with {}", set.join(" ")) },
+        tests.note,
         if args.rows.is_empty() { "" } else { " --rows" },
         match (args.phases, phases.is_empty()) {
             (Some(_), _) => " --phases",
@@ -734,7 +771,7 @@ fn ballistic(
         }
     );
     let title = format!("{}: v_r against v_i at {}", case.title, plugsim::ballistic::ladder_extent(&rungs));
-    let files = write_ladder_files(&out_dir, &header, &title, &rungs, &speeds, &experiments)?;
+    let files = write_ladder_files(&out_dir, &header, &title, &rungs, &speeds, &tests.points)?;
     println!("{}", plugsim::ballistic::ladder_table(&rungs, &speeds).0);
     for f in files {
         println!("written: {}", f.display());
@@ -765,7 +802,7 @@ fn one_study(
     projectile: plugsim::ballistic::Projectile,
     out_dir: &Path,
     args: &BallisticArgs,
-    experiments: &[(f64, f64)],
+    tests: &Tests,
     interrupt: &Option<Arc<AtomicBool>>,
     started: Instant,
 ) -> Result<(plugsim::ballistic::Study, Option<plugsim::ballistic::EdgePhase>)> {
@@ -798,16 +835,17 @@ fn one_study(
     let edge_phase = plugsim::ballistic::edge_phase(&setup.case, projectile);
     let edge = edge_phase.map_or(String::new(), |e| format!("; {}", e.describe()));
     let header = format!(
-        "Case {file}{}; projectile `{body}` (case impact speed {impact:.1} m/s{kind}){edge}; {jobs} runs side by side, {threads_per_run} thread(s) each, \
+        "Case {file}{}; projectile `{body}` (case impact speed {impact:.1} m/s{kind}){edge}{}; {jobs} runs side by side, {threads_per_run} thread(s) each, \
          a snapshot every {:.3} us; produced by `plugsim ballistic` ({} {}) on {}.",
         if set.is_empty() { String::new() } else { format!(" with {}", set.join(" ")) },
+        tests.note,
         snapshots * 1e6,
         env!("CARGO_PKG_VERSION"),
         env!("PLUGSIM_COMMIT"),
         cpu_name()
     );
     let title = format!("{}: residual against impact velocity", setup.case.title);
-    let mut report = |study: &Study| write_files(out_dir, &header, &title, study, experiments).map(|_| ());
+    let mut report = |study: &Study| write_files(out_dir, &header, &title, study, &tests.points).map(|_| ());
     let study_started = Instant::now();
     let mut progress = |e: Event| {
         let at = started.elapsed().as_secs_f64();
@@ -856,7 +894,7 @@ fn one_study(
         let bounds = (args.lo.unwrap_or(0.5 * impact), args.hi.unwrap_or(impact));
         find_limit(&setup, bounds, args.tol, &mut study, &mut report, &mut progress)?;
     }
-    let files = write_files(out_dir, &header, &title, &study, experiments)?;
+    let files = write_files(out_dir, &header, &title, &study, &tests.points)?;
     println!("{}", plugsim::ballistic::report(&header, &study));
     println!("total wall time {:.1} s", study_started.elapsed().as_secs_f64());
     for f in files {

@@ -710,3 +710,47 @@ fn check_and_run_state_the_projectile_s_edge_against_the_columns() {
     assert!(o.status.success() && !stdout.contains("rim "), "{stdout}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A built-in case's tests go on its curve while the overrides change the
+/// model only (material, resolution, speed); another plate thickness or
+/// another projectile is another experiment, and the reason is named.
+#[test]
+fn a_built_in_cases_tests_belong_to_its_plate_and_projectile_only() {
+    use plugsim::ballistic::tests_differ;
+    use plugsim::cases::{builtin_case, builtin_experiments};
+    let load = |name: &str, set: &[&str]| {
+        let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+        Case::from_str_with(builtin_case(name).unwrap(), name, &set).unwrap()
+    };
+    for name in ["borvik-2002-12mm-hemispherical", "borvik-2-axisymmetric-nonlocal", "borvik-1-axisymmetric-deformable"]
+    {
+        let shipped = load(name, &[]);
+        assert!(builtin_experiments(name).is_some(), "{name} has tests");
+        assert_eq!(tests_differ(&shipped, &shipped), None, "{name}");
+        let model = load(
+            name,
+            &[
+                "bodies.plate.material=weldox_460e_cockcroft_latham",
+                "bodies.plate.rectangle.layers=12",
+                "time.end=1e-4",
+            ],
+        );
+        assert_eq!(tests_differ(&shipped, &model), None, "{name}: the model changed, not the experiment");
+        let thinner = load(name, &["bodies.plate.rectangle.y_min=0.002"]);
+        let why = tests_differ(&shipped, &thinner).unwrap_or_else(|| panic!("{name}: a thinner plate"));
+        assert!(why.contains("thick"), "{name}: {why}");
+    }
+    let hemi = "borvik-2002-12mm-hemispherical";
+    let heavier = load(hemi, &["rigid_bodies.projectile.mass=0.25"]);
+    let why = tests_differ(&load(hemi, &[]), &heavier).expect("a heavier projectile");
+    assert!(why.contains("rigid projectile"), "{why}");
+    let faster = load(hemi, &["rigid_bodies.projectile.velocity=[0.0, -350.0]"]);
+    assert_eq!(tests_differ(&load(hemi, &[]), &faster), None, "a study sets the speed itself");
+    let deformable = "borvik-1-axisymmetric-deformable";
+    let longer = load(deformable, &["bodies.projectile.rectangle.y_max=0.1"]);
+    let why = tests_differ(&load(deformable, &[]), &longer).expect("a longer projectile");
+    assert!(why.contains("deformable projectile"), "{why}");
+    // the blunt nose's tests are not the hemispherical nose's
+    let blunt = load("borvik-2002-12mm-blunt", &[]);
+    assert!(tests_differ(&load(hemi, &[]), &blunt).is_some());
+}

@@ -281,8 +281,9 @@ fn a_projectile_is_through_one_plate_thickness_past_the_back_face() {
 /// what the data file `borvik-experiments.toml` and the SPEC's table say:
 /// each nose's held shots and its published limit as points with `v_r = 0`
 /// (no more, no less), and Case I's and II's tests as
-/// [`EXPERIMENTS`] has them. A CSV edited without its source, or a source
-/// edited without its CSV, fails here.
+/// [`EXPERIMENTS`] has them; and each is the one a built-in case carries
+/// (`cases::BUILTIN_EXPERIMENTS`). A CSV edited without its source, or a
+/// source edited without its CSV, fails here.
 #[test]
 fn reference_experiment_files_agree_with_the_data_file() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/reference");
@@ -300,6 +301,16 @@ fn reference_experiment_files_agree_with_the_data_file() {
         let name = path.file_stem().unwrap().to_str().unwrap();
         let points = plugsim::ballistic::read_experiments(path).unwrap_or_else(|e| panic!("{e}"));
         assert!(!points.is_empty(), "{name}: no points");
+        // the built-in cases carry this file as it is (`plugsim ballistic` plots it)
+        let file = format!("cases/reference/{name}.csv");
+        let carried = plugsim::cases::BUILTIN_EXPERIMENTS.iter().find(|e| e.1 == file);
+        let carried = carried.unwrap_or_else(|| panic!("{name}: no built-in case carries it"));
+        assert_eq!(carried.2, std::fs::read_to_string(path).unwrap(), "{name}");
+        assert!(
+            plugsim::cases::BUILTIN_CASES.iter().any(|c| c.0.starts_with(carried.0)),
+            "{name}: `{}` names no built-in case",
+            carried.0
+        );
         let case = EXPERIMENTS.iter().find(|e| name == format!("borvik-{}", e.name));
         let mut expected: Vec<(Real, Real)> = match case {
             Some(e) => vec![(e.impact_velocity, e.residual)],
