@@ -254,8 +254,8 @@ pub const BUILTIN_EXPERIMENTS: &[(&str, &str, &str)] = &[
 /// The tests of built-in case `name` (or its alias), `(file, CSV text)`,
 /// where [`BUILTIN_EXPERIMENTS`] has them.
 pub fn builtin_experiments(name: &str) -> Option<(&'static str, &'static str)> {
+    builtin_case(name)?;
     let name = resolve_alias(name);
-    BUILTIN_CASES.iter().find(|c| c.0 == name)?;
     BUILTIN_EXPERIMENTS.iter().find(|e| name.starts_with(e.0)).map(|e| (e.1, e.2))
 }
 

@@ -237,9 +237,8 @@ fn dispatch(cmd: Command) -> Result<()> {
     match cmd {
         Command::Cases => list_cases(),
         Command::Ballistic { case_file, case, set, out, args } => {
-            let builtin = case.clone();
-            let (case, name, file) = load(&case_file, &case, &set)?;
-            ballistic(case, &name, &file, builtin.as_deref(), &set, out, *args)
+            let (loaded, name, file) = load(&case_file, &case, &set)?;
+            ballistic(loaded, &name, &file, case.as_deref(), &set, out, *args)
         }
         Command::Bench { case, steps, whole, set } => bench(&case, steps, whole, &set),
         Command::Validate { out, all, only, full_time, family, set } => match family.as_str() {
@@ -645,10 +644,12 @@ fn study_tests(given: Option<&Path>, builtin: Option<&str>, case: &Case) -> Resu
         let note = format!("; experiments on the plot: {} ({} points)", path.display(), points.len());
         return Ok(Tests { points, note });
     }
-    let Some((name, (path, text))) = builtin.and_then(|n| Some((n, plugsim::cases::builtin_experiments(n)?))) else {
-        return Ok(Tests { points: Vec::new(), note: String::new() });
+    let none = Tests { points: Vec::new(), note: String::new() };
+    let Some(name) = builtin else { return Ok(none) };
+    let (Some((path, text)), Some(shipped)) = (plugsim::cases::builtin_experiments(name), builtin_case(name)) else {
+        return Ok(none);
     };
-    let shipped = Case::from_str_with(builtin_case(name).unwrap_or_default(), &format!("<built-in {name}>"), &[])?;
+    let shipped = Case::from_str_with(shipped, &format!("<built-in {name}>"), &[])?;
     if let Some(why) = tests_differ(&shipped, case) {
         eprintln!("plugsim ballistic: the built-in case's tests ({path}) are not plotted: {why}");
         return Ok(Tests {
