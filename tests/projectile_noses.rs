@@ -8,6 +8,9 @@ use plugsim::case::Case;
 use plugsim::math::{Real, Vec2};
 use plugsim::run::build_simulation;
 
+#[macro_use]
+mod common;
+
 /// A free (unsupported) elastic plate, 6 mm thick, and a 10 mm
 /// hemispherical-nosed projectile 0.05 mm above it, at 100 m/s.
 fn case(mode: &str, projectile: &str) -> String {
@@ -15,11 +18,7 @@ fn case(mode: &str, projectile: &str) -> String {
         r#"
 [geometry]
 mode = "{mode}"
-[materials.steel]
-model = "elastic"
-density = 7850.0
-youngs_modulus = 200.0e9
-poisson_ratio = 0.3
+{steel}
 [[bodies]]
 name = "plate"
 material = "steel"
@@ -37,6 +36,7 @@ velocity = [0.0, -100.0]
 [time]
 end = 8.0e-6
 "#,
+        steel = elastic_steel!(),
         x_min = if mode == "axisymmetric" { "0.0" } else { "-0.02" },
     )
 }
@@ -206,14 +206,12 @@ fn hemispherical_impact_conserves_momentum_and_does_not_penetrate() {
 /// between those rings, no finer.
 #[test]
 fn a_hemispherical_nose_pressed_into_an_elastic_plate_carries_hertz_force() {
-    let text = r#"
+    let text = concat!(
+        "
 [geometry]
-mode = "axisymmetric"
-[materials.steel]
-model = "elastic"
-density = 7850.0
-youngs_modulus = 200.0e9
-poisson_ratio = 0.3
+mode = \"axisymmetric\"",
+        elastic_steel!(),
+        r#"
 [[bodies]]
 name = "plate"
 material = "steel"
@@ -243,7 +241,8 @@ velocity = [0.0, -2.0]
 prescribed = true
 [time]
 end = 25.0e-6
-"#;
+"#
+    );
     let c = Case::from_str_with(text, "hertz.toml", &[]).unwrap().resolved();
     let mut sim = build_simulation(&c).unwrap();
     let (radius, e_star, h) = (0.01, 200.0e9 / (1.0 - 0.3 * 0.3), 0.00025);

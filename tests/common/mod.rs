@@ -4,21 +4,33 @@ use plugsim::case::Case;
 use plugsim::discretize::RectangleGrid;
 use plugsim::math::Real;
 
-/// The head of the small elastic cases: `[geometry]` in plane strain and
 /// `[materials.steel]`, elastic steel (ρ = 7850 kg/m³, E = 200 GPa,
-/// ν = 0.3); a string literal, for `concat!` with the rest of a case.
+/// ν = 0.3) of the small elastic cases; a string literal, for `concat!`
+/// (or `format!`) with the rest of a case.
 #[allow(unused_macros)] // not every test binary uses every helper
-macro_rules! elastic_steel_plane_strain {
+macro_rules! elastic_steel {
     () => {
         "
-[geometry]
-mode = \"plane_strain\"
 [materials.steel]
 model = \"elastic\"
 density = 7850.0
 youngs_modulus = 200.0e9
 poisson_ratio = 0.3
 "
+    };
+}
+
+/// The head of the small elastic cases: `[geometry]` in plane strain and
+/// [`elastic_steel`]'s `[materials.steel]`.
+#[allow(unused_macros)] // not every test binary uses every helper
+macro_rules! elastic_steel_plane_strain {
+    () => {
+        concat!(
+            "
+[geometry]
+mode = \"plane_strain\"",
+            elastic_steel!()
+        )
     };
 }
 
