@@ -186,6 +186,13 @@ fn hemispherical_impact_conserves_momentum_and_does_not_penetrate() {
     }
 }
 
+/// The face of the Hertz tests' plate, where the nose's tip starts, m:
+/// the nose's depth is `PLATE_TOP − y_tip`.
+const PLATE_TOP: Real = 0.02;
+
+/// `E* = E/(1−ν²)` of [`elastic_steel`]'s steel (E = 200 GPa, ν = 0.3), Pa.
+const E_STAR: Real = 200.0e9 / (1.0 - 0.3 * 0.3);
+
 /// The Hertz tests' case: the Børvik cases' 10 mm nose radius, its tip on
 /// the face of an elastic steel plate (axisymmetric, 20 mm thick, clamped
 /// underneath, 0.25 mm particles out to 3 mm from the axis and graded
@@ -204,7 +211,7 @@ material = "steel"
 x_min = 0.0
 x_max = 0.02
 y_min = 0.0
-y_max = 0.02
+y_max = {PLATE_TOP}
 layers = 80
 refine_at = 0.0
 fine_half_width = 0.003
@@ -220,7 +227,7 @@ y_min = 0.0
 y_max = 0.0001
 [[rigid_bodies]]
 name = "projectile"
-projectile = {{ nose = "hemispherical", tip = [0.0, 0.02], diameter = 0.02, length = 0.02 }}
+projectile = {{ nose = "hemispherical", tip = [0.0, {PLATE_TOP}], diameter = 0.02, length = 0.02 }}
 density = 7850.0
 velocity = [0.0, -{speed}]
 prescribed = {prescribed}
@@ -232,10 +239,9 @@ end = {end:e}
 }
 
 /// Hertz's `F = (4/3) E* √R δ^{3/2}`, N, for a rigid sphere of radius `R`
-/// at depth `δ` in elastic steel (`E* = E/(1−ν²)`, E = 200 GPa, ν = 0.3).
+/// at depth `δ` in elastic steel ([`E_STAR`]).
 fn hertz_force(radius: Real, depth: Real) -> Real {
-    let e_star = 200.0e9 / (1.0 - 0.3 * 0.3);
-    4.0 / 3.0 * e_star * radius.sqrt() * depth.max(0.0).powf(1.5)
+    4.0 / 3.0 * E_STAR * radius.sqrt() * depth.max(0.0).powf(1.5)
 }
 
 /// Hertz (1882): a rigid sphere of radius `R` pressed a depth `δ` into an
@@ -265,7 +271,7 @@ fn a_hemispherical_nose_pressed_into_an_elastic_plate_carries_hertz_force() {
     while sim.time < c.time.end {
         sim.step().unwrap();
         let body = sim.contact.as_ref().unwrap().sample(0).unwrap();
-        let depth = 0.02 - body.position.y;
+        let depth = PLATE_TOP - body.position.y;
         let a = (radius * depth).sqrt();
         if a < 2.0 * h {
             continue;
@@ -275,7 +281,7 @@ fn a_hemispherical_nose_pressed_into_an_elastic_plate_carries_hertz_force() {
         let rings = body.active_contacts as Real;
         assert!((rings - (a / h + 1.0)).abs() <= 1.0, "{rings} slaves in contact over a = {:.2} spacings", a / h);
     }
-    let depth = 0.02 - sim.contact.as_ref().unwrap().sample(0).unwrap().position.y;
+    let depth = PLATE_TOP - sim.contact.as_ref().unwrap().sample(0).unwrap().position.y;
     assert!((depth - 0.05e-3).abs() < 1e-7, "the nose is driven to 0.05 mm: {depth:e}");
     assert!(samples > 100, "{samples} steps with a patch of two spacings or more");
     assert!(lowest > 0.93 && highest < 1.07, "F / F_Hertz within {lowest:.3}…{highest:.3}");
@@ -302,14 +308,13 @@ fn a_hemispherical_nose_striking_an_elastic_plate_follows_hertz_impact() {
     let c = Case::from_str_with(&hertz_case(speed, false, 45.0e-6), "hertz.toml", &[]).unwrap().resolved();
     let mut sim = build_simulation(&c).unwrap();
     let mass = sim.contact.as_ref().unwrap().bodies[0].mass;
-    let e_star = 200.0e9 / (1.0 - 0.3 * 0.3);
-    let depth_max = (15.0 * mass * speed * speed / (16.0 * e_star * radius.sqrt())).powf(0.4);
+    let depth_max = (15.0 * mass * speed * speed / (16.0 * E_STAR * radius.sqrt())).powf(0.4);
     let duration = 2.943 * depth_max / speed;
     let (mut deepest, mut peak, mut first, mut last): (Real, Real, Option<Real>, Real) = (0.0, 0.0, None, 0.0);
     while sim.time < c.time.end {
         sim.step().unwrap();
         let body = sim.contact.as_ref().unwrap().sample(0).unwrap();
-        deepest = deepest.max(0.02 - body.position.y);
+        deepest = deepest.max(PLATE_TOP - body.position.y);
         if body.contact_force.y != 0.0 {
             peak = peak.max(body.contact_force.y.abs());
             first.get_or_insert(sim.time);
