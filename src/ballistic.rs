@@ -1402,6 +1402,25 @@ fn dots(points: impl Iterator<Item = (Real, Real)>) -> Vec<(Real, Real)> {
     points.flat_map(|q| [q, (Real::NAN, Real::NAN)]).collect()
 }
 
+/// Longest `--set` override a plot's title spells out; more or longer
+/// ones are counted, their text being in the report's header.
+const TITLE_OVERRIDE_CHARS: usize = 60;
+
+/// A study plot's title: the case's own title, then what the `--set`
+/// overrides changed, then `what`. A built-in's title names its fracture
+/// model and material, which an override may have swapped, so a plot
+/// without that mark would say what was not run.
+pub fn study_title(case_title: &str, overrides: &[String], what: &str) -> String {
+    let with = match overrides {
+        [] => String::new(),
+        [one] if one.chars().count() <= TITLE_OVERRIDE_CHARS => format!(", with {one}"),
+        many => {
+            format!(", with {} --set override{} (see the report)", many.len(), if many.len() == 1 { "" } else { "s" })
+        }
+    };
+    format!("{case_title}{with}: {what}")
+}
+
 /// The `v_r(v_i)` plot: the runs as points, the fit as a curve, the
 /// experimental points if any.
 pub fn plot(study: &Study, title: &str, experiments: &[(Real, Real)]) -> LinePlot {
@@ -1786,6 +1805,18 @@ pub fn write_files(
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn a_study_title_marks_the_overrides() {
+        let what = "residual against impact velocity";
+        assert_eq!(study_title("Case I", &[], what), "Case I: residual against impact velocity");
+        let one = vec!["time.end=2e-4".to_string()];
+        assert_eq!(study_title("Case I", &one, what), "Case I, with time.end=2e-4: residual against impact velocity");
+        let long = vec![format!("bodies.plate.material={}", "x".repeat(60))];
+        assert!(study_title("Case I", &long, what).contains(", with 1 --set override (see the report)"));
+        let two = vec!["a=1".to_string(), "b=2".to_string()];
+        assert!(study_title("Case I", &two, what).starts_with("Case I, with 2 --set overrides (see the report): "));
+    }
     use super::*;
 
     /// `--speeds` items: a speed, an inclusive range, and each malformed

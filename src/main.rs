@@ -771,7 +771,11 @@ fn ballistic(
             ""
         }
     );
-    let title = format!("{}: v_r against v_i at {}", case.title, plugsim::ballistic::ladder_extent(&rungs));
+    let title = plugsim::ballistic::study_title(
+        &case.title,
+        set,
+        &format!("v_r against v_i at {}", plugsim::ballistic::ladder_extent(&rungs)),
+    );
     let files = write_ladder_files(&out_dir, &header, &title, &rungs, &speeds, &tests.points)?;
     println!("{}", plugsim::ballistic::ladder_table(&rungs, &speeds).0);
     for f in files {
@@ -845,7 +849,7 @@ fn one_study(
         env!("PLUGSIM_COMMIT"),
         cpu_name()
     );
-    let title = format!("{}: residual against impact velocity", setup.case.title);
+    let title = plugsim::ballistic::study_title(&setup.case.title, set, "residual against impact velocity");
     let mut report = |study: &Study| write_files(out_dir, &header, &title, study, &tests.points).map(|_| ());
     let study_started = Instant::now();
     let mut progress = |e: Event| {
