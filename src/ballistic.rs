@@ -1805,6 +1805,7 @@ pub fn write_files(
 
 #[cfg(test)]
 mod tests {
+    use super::*;
 
     #[test]
     fn a_study_title_marks_the_overrides() {
@@ -1817,7 +1818,6 @@ mod tests {
         let two = vec!["a=1".to_string(), "b=2".to_string()];
         assert!(study_title("Case I", &two, what).starts_with("Case I, with 2 --set overrides (see the report): "));
     }
-    use super::*;
 
     /// `--speeds` items: a speed, an inclusive range, and each malformed
     /// item refused naming it.

@@ -190,10 +190,13 @@ fn hemispherical_impact_conserves_momentum_and_does_not_penetrate() {
 /// the nose's depth is `PLATE_TOP − y_tip`.
 const PLATE_TOP: Real = 0.02;
 
+/// The Hertz tests' nose radius `R` (the Børvik cases'), m.
+const NOSE_RADIUS: Real = 0.01;
+
 /// `E* = E/(1−ν²)` of [`elastic_steel`]'s steel (E = 200 GPa, ν = 0.3), Pa.
 const E_STAR: Real = 200.0e9 / (1.0 - 0.3 * 0.3);
 
-/// The Hertz tests' case: the Børvik cases' 10 mm nose radius, its tip on
+/// The Hertz tests' case: a nose of [`NOSE_RADIUS`], its tip on
 /// the face of an elastic steel plate (axisymmetric, 20 mm thick, clamped
 /// underneath, 0.25 mm particles out to 3 mm from the axis and graded
 /// beyond), moving down at `speed` (m/s), held at that speed if
@@ -227,7 +230,7 @@ y_min = 0.0
 y_max = 0.0001
 [[rigid_bodies]]
 name = "projectile"
-projectile = {{ nose = "hemispherical", tip = [0.0, {PLATE_TOP}], diameter = 0.02, length = 0.02 }}
+projectile = {{ nose = "hemispherical", tip = [0.0, {PLATE_TOP}], diameter = {diameter}, length = {diameter} }}
 density = 7850.0
 velocity = [0.0, -{speed}]
 prescribed = {prescribed}
@@ -235,13 +238,14 @@ prescribed = {prescribed}
 end = {end:e}
 "#,
         steel = elastic_steel!(),
+        diameter = 2.0 * NOSE_RADIUS,
     )
 }
 
-/// Hertz's `F = (4/3) E* √R δ^{3/2}`, N, for a rigid sphere of radius `R`
-/// at depth `δ` in elastic steel ([`E_STAR`]).
-fn hertz_force(radius: Real, depth: Real) -> Real {
-    4.0 / 3.0 * E_STAR * radius.sqrt() * depth.max(0.0).powf(1.5)
+/// Hertz's `F = (4/3) E* √R δ^{3/2}`, N, for the rigid sphere of radius
+/// [`NOSE_RADIUS`] at depth `δ` in elastic steel ([`E_STAR`]).
+fn hertz_force(depth: Real) -> Real {
+    4.0 / 3.0 * E_STAR * NOSE_RADIUS.sqrt() * depth.max(0.0).powf(1.5)
 }
 
 /// Hertz (1882): a rigid sphere of radius `R` pressed a depth `δ` into an
@@ -266,17 +270,17 @@ fn a_hemispherical_nose_pressed_into_an_elastic_plate_carries_hertz_force() {
     let text = hertz_case(2.0, true, 25.0e-6);
     let c = Case::from_str_with(&text, "hertz.toml", &[]).unwrap().resolved();
     let mut sim = build_simulation(&c).unwrap();
-    let (radius, h) = (0.01, 0.00025);
+    let h = 0.00025;
     let (mut lowest, mut highest, mut samples): (Real, Real, usize) = (Real::INFINITY, 0.0, 0);
     while sim.time < c.time.end {
         sim.step().unwrap();
         let body = sim.contact.as_ref().unwrap().sample(0).unwrap();
         let depth = PLATE_TOP - body.position.y;
-        let a = (radius * depth).sqrt();
+        let a = (NOSE_RADIUS * depth).sqrt();
         if a < 2.0 * h {
             continue;
         }
-        let ratio = body.contact_force.y.abs() / hertz_force(radius, depth);
+        let ratio = body.contact_force.y.abs() / hertz_force(depth);
         (lowest, highest, samples) = (lowest.min(ratio), highest.max(ratio), samples + 1);
         let rings = body.active_contacts as Real;
         assert!((rings - (a / h + 1.0)).abs() <= 1.0, "{rings} slaves in contact over a = {:.2} spacings", a / h);
@@ -304,11 +308,11 @@ fn a_hemispherical_nose_pressed_into_an_elastic_plate_carries_hertz_force() {
 /// is no half-space over 36 µs (Hertz's rebound is not asserted).
 #[test]
 fn a_hemispherical_nose_striking_an_elastic_plate_follows_hertz_impact() {
-    let (radius, speed): (Real, Real) = (0.01, 10.0);
+    let speed: Real = 10.0;
     let c = Case::from_str_with(&hertz_case(speed, false, 45.0e-6), "hertz.toml", &[]).unwrap().resolved();
     let mut sim = build_simulation(&c).unwrap();
     let mass = sim.contact.as_ref().unwrap().bodies[0].mass;
-    let depth_max = (15.0 * mass * speed * speed / (16.0 * E_STAR * radius.sqrt())).powf(0.4);
+    let depth_max = (15.0 * mass * speed * speed / (16.0 * E_STAR * NOSE_RADIUS.sqrt())).powf(0.4);
     let duration = 2.943 * depth_max / speed;
     let (mut deepest, mut peak, mut first, mut last): (Real, Real, Option<Real>, Real) = (0.0, 0.0, None, 0.0);
     while sim.time < c.time.end {
@@ -326,11 +330,11 @@ fn a_hemispherical_nose_striking_an_elastic_plate_follows_hertz_impact() {
     eprintln!(
         "δ_max {:+.3}, F_max {:+.3}, t_c {:+.3} against Hertz",
         rel(deepest, depth_max),
-        rel(peak, hertz_force(radius, depth_max)),
+        rel(peak, hertz_force(depth_max)),
         rel(contact_time, duration)
     );
     assert!(rel(deepest, depth_max).abs() < 0.04, "δ_max {deepest:e} against {depth_max:e} m");
-    assert!(rel(peak, hertz_force(radius, depth_max)).abs() < 0.07, "F_max {peak:.0} N");
+    assert!(rel(peak, hertz_force(depth_max)).abs() < 0.07, "F_max {peak:.0} N");
     assert!(rel(contact_time, duration).abs() < 0.05, "t_c {contact_time:e} against {duration:e} s");
     let rebound = sim.contact.as_ref().unwrap().bodies[0].velocity.y;
     assert!(rebound > 0.5 * speed && rebound < speed, "the nose rebounds, slower: {rebound} m/s");
