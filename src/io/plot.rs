@@ -259,10 +259,14 @@ fn draw_line_plot(root: &Area, plot: &LinePlot) -> Result<(), String> {
         }
     }
 
-    if plot.series.iter().any(|s| !s.name.is_empty()) {
+    let names: Vec<&str> = plot.series.iter().map(|s| s.name.as_str()).filter(|n| !n.is_empty()).collect();
+    if !names.is_empty() {
+        let area = chart.plotting_area().dim_in_pixel();
+        let legend = legend_box_fraction(&names, (area.0 as f64, area.1 as f64));
+        let samples = plot_samples(plot, ((x0, x1), (y0, y1)));
         chart
             .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
+            .position(least_covered_corner(&samples, legend).position())
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .label_font((FONT, 16))
@@ -270,6 +274,86 @@ fn draw_line_plot(root: &Area, plot: &LinePlot) -> Result<(), String> {
             .map_err(|e| e.to_string())?;
     }
     Ok(())
+}
+
+/// A corner of the plot area, where the legend goes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Corner {
+    UpperRight,
+    UpperLeft,
+    LowerRight,
+    LowerLeft,
+}
+
+impl Corner {
+    /// In order of preference when the data leave more than one free.
+    const ALL: [Corner; 4] = [Corner::UpperRight, Corner::UpperLeft, Corner::LowerRight, Corner::LowerLeft];
+
+    fn position(self) -> SeriesLabelPosition {
+        match self {
+            Corner::UpperRight => SeriesLabelPosition::UpperRight,
+            Corner::UpperLeft => SeriesLabelPosition::UpperLeft,
+            Corner::LowerRight => SeriesLabelPosition::LowerRight,
+            Corner::LowerLeft => SeriesLabelPosition::LowerLeft,
+        }
+    }
+
+    /// Whether `p` (x, y as fractions of the plot area, y up) lies inside
+    /// a box of `size` (width, height fractions) in this corner.
+    fn covers(self, size: (f64, f64), p: (f64, f64)) -> bool {
+        let right = matches!(self, Corner::UpperRight | Corner::LowerRight);
+        let upper = matches!(self, Corner::UpperRight | Corner::UpperLeft);
+        let in_x = if right { p.0 >= 1.0 - size.0 } else { p.0 <= size.0 };
+        let in_y = if upper { p.1 >= 1.0 - size.1 } else { p.1 <= size.1 };
+        in_x && in_y
+    }
+}
+
+/// The legend's box as fractions (width, height) of a plot area of `area`
+/// pixels, for the entries `names` at the legend's 16 px font: a 25 px
+/// line sample, an average glyph width of 0.55 em, a row of about 22 px
+/// and plotters' padding, with a few pixels' allowance for the dots.
+fn legend_box_fraction(names: &[&str], area: (f64, f64)) -> (f64, f64) {
+    let chars = names.iter().map(|n| n.chars().count()).max().unwrap_or(0) as f64;
+    let width = 25.0 + 0.55 * 16.0 * chars + 40.0;
+    let height = 22.0 * names.len() as f64 + 24.0;
+    ((width / area.0.max(1.0)).min(1.0), (height / area.1.max(1.0)).min(1.0))
+}
+
+/// Where `plot` draws, as fractions of its `ranges` (x, y): every finite
+/// point of every series, 16 points along each segment between them, and
+/// 33 points along each reference line.
+fn plot_samples(plot: &LinePlot, ranges: ((f64, f64), (f64, f64))) -> Vec<(f64, f64)> {
+    let ((x0, x1), (y0, y1)) = ranges;
+    let unit = |p: (f64, f64)| ((p.0 - x0) / (x1 - x0), (p.1 - y0) / (y1 - y0));
+    let mut samples = Vec::new();
+    for series in &plot.series {
+        for run in finite_runs(&series.points) {
+            samples.extend(run.iter().copied().map(unit));
+            for pair in run.windows(2) {
+                let (a, b) = (unit(pair[0]), unit(pair[1]));
+                samples.extend((1..16).map(|k| {
+                    let t = f64::from(k) / 16.0;
+                    (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1))
+                }));
+            }
+        }
+    }
+    for (_, y) in plot.hlines.iter().filter(|h| h.1.is_finite()) {
+        let y = (y.clamp(-AXIS_LIMIT, AXIS_LIMIT) - y0) / (y1 - y0);
+        samples.extend((0..=32).map(|k| (f64::from(k) / 32.0, y)));
+    }
+    samples
+}
+
+/// The corner whose legend box of `size` (fractions of the plot area)
+/// covers the fewest of `samples` (fractions, y up): the first of
+/// [`Corner::ALL`] among equals, upper right when nothing is drawn. A
+/// ballistic curve rises to the upper right, where a fixed legend hid its
+/// fastest runs and the experiments beside them.
+fn least_covered_corner(samples: &[(f64, f64)], size: (f64, f64)) -> Corner {
+    let covered = |corner: Corner| samples.iter().filter(|p| corner.covers(size, **p)).count();
+    Corner::ALL.into_iter().min_by_key(|c| covered(*c)).unwrap_or(Corner::UpperRight)
 }
 
 /// Width of the colour-bar strip at the right of a field plot, pixels.
@@ -606,6 +690,38 @@ mod tests {
             ],
             hlines: vec![("ballistic limit".into(), 120.0), ("zero".into(), 0.0)],
         }
+    }
+
+    #[test]
+    fn the_legend_takes_the_corner_the_data_leave_free() {
+        let size = (0.4, 0.2);
+        // A ballistic curve: held runs along the bottom, then rising to
+        // the upper right; the upper left is free.
+        let curve = LinePlot {
+            series: vec![Series {
+                name: "simulated".into(),
+                points: vec![(80.0, 0.0), (120.0, 0.0), (125.0, 40.0), (200.0, 150.0), (300.0, 250.0)],
+            }],
+            ..LinePlot::default()
+        };
+        let samples = plot_samples(&curve, ((75.0, 310.0), (-10.0, 260.0)));
+        assert!(samples.iter().all(|p| (0.0..=1.0).contains(&p.0) && (0.0..=1.0).contains(&p.1)));
+        assert_eq!(least_covered_corner(&samples, size), Corner::UpperLeft);
+        // A decaying history fills the upper left and the bottom; the upper
+        // right is free and stays preferred.
+        let samples = plot_samples(&sample_line_plot(), ((0.0, 20.0), (-15.0, 315.0)));
+        assert_eq!(least_covered_corner(&samples, size), Corner::UpperRight);
+        // One point in each upper corner, none below: the lower right.
+        assert_eq!(least_covered_corner(&[(0.95, 0.95), (0.05, 0.95)], size), Corner::LowerRight);
+        assert_eq!(least_covered_corner(&[], size), Corner::UpperRight);
+        // A reference line across the top counts in both upper corners.
+        let hline = LinePlot { hlines: vec![("limit".into(), 0.95)], ..LinePlot::default() };
+        let samples = plot_samples(&hline, ((0.0, 1.0), (0.0, 1.0)));
+        assert_eq!(least_covered_corner(&samples, size), Corner::LowerRight);
+        // The box grows with the longest entry and the number of entries.
+        let (w1, h1) = legend_box_fraction(&["a"], (800.0, 500.0));
+        let (w2, h2) = legend_box_fraction(&["a", "Recht-Ipson a = 0.843, p = 3.20"], (800.0, 500.0));
+        assert!(w2 > w1 && h2 > h1 && w2 <= 1.0 && h2 <= 1.0, "{w1} {h1} {w2} {h2}");
     }
 
     #[test]
