@@ -423,7 +423,8 @@ impl OutputWriter {
     }
 
     /// Whether every moving body's flight is over, by the definitions
-    /// of [`crate::residual`] held for `wait` (s): stopped or moving back, or
+    /// of [`crate::residual`] held for `wait` (s): stopped or moving back,
+    /// slowed with no plug cut out, or
     /// free of force along its flight with a plug cut out (both for `wait`:
     /// the plug, thrown ahead, may still be caught again) or through its
     /// target (free for `wait`). Call
@@ -457,8 +458,10 @@ impl OutputWriter {
             let passed = crate::residual::is_through(s.position.dot(&dir), through);
             let free = (passed || cut.is_some_and(|c| sim.time - c >= wait))
                 && tracker.free_for(sim.time).is_some_and(|t| t >= wait);
+            // Slowed with no plug cut out, for `wait`.
+            let slow = cut.is_none() && !passed && tracker.slow_for(sim.time).is_some_and(|t| t >= wait);
             moving += 1;
-            over += usize::from(stopped || free);
+            over += usize::from(stopped || free || slow);
         }
         moving > 0 && over == moving
     }

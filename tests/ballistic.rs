@@ -171,6 +171,30 @@ fn speeds_run_side_by_side_and_the_limit_is_bracketed() {
     std::fs::remove_dir_all(&s.out_dir).ok();
 }
 
+/// A projectile braked below 5 % of its impact speed with no plug cut out
+/// is held (`plugsim::residual`, "Held without a plug"): at 60 m/s the
+/// small plate slows it through 3 m/s before it stops, and the run ends the
+/// study's wait after that, not after the stop; the history shows the
+/// speed between 1 % and 5 % of the impact at the verdict's time.
+#[test]
+fn a_projectile_slowed_with_no_plug_is_held_and_the_run_ends() {
+    let s = setup("slow", 1);
+    let mut study = Study::default();
+    run_speeds(&s, &[60.0], &mut study, &mut |_| Ok(()), &mut |_| {}).unwrap();
+    let shot = &study.shots[0];
+    let Verdict::Held { since } = shot.verdict else { panic!("{:?}", shot.verdict) };
+    assert!(shot.plug_mass.unwrap_or(0.0) == 0.0 && shot.perforation.is_none(), "{shot:?}");
+    let history = plugsim::output::read_history(&shot.dir).unwrap();
+    let (t, vy) = (history.column("time").unwrap(), history.column("projectile_vy").unwrap());
+    let at = t.iter().position(|&x| x == since).expect("the verdict's time is a history row");
+    let slowed = -vy[at];
+    assert!(slowed > 0.01 * 60.0 && slowed <= 0.05 * 60.0, "{slowed} m/s at {since} s");
+    assert!(-vy[at - 1] > 0.05 * 60.0, "the first row at 5 % or below");
+    // Ended the wait (2 us) after it, within a history row's steps.
+    assert!(shot.end_time >= since + 2.0e-6 && shot.end_time < since + 2.5e-6, "{} {since}", shot.end_time);
+    std::fs::remove_dir_all(&s.out_dir).ok();
+}
+
 /// A run the plate has neither held nor let go at the case's end time goes
 /// on, up to the study's max time, and stops once decided; with the max
 /// time at the end time it stops undecided there, as before.
