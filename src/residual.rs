@@ -49,9 +49,11 @@
 //!   no more than the speed it had, and a Recht–Ipson curve
 //!   `v_r = a (v_iᵖ − v_blᵖ)^(1/p)` puts that run's speed above the limit
 //!   by `Δv = v_bl (v_r/(a v_bl))ᵖ / p`: at `v_r = 0.05 v_bl`, `a ≥ 0.8`
-//!   and `p ≥ 2` (the plates' fits: `a` = 0.84–0.96, `p` = 2–3.5) under
-//!   0.2 % of the limit, a fifth of the ±1 m/s a search is asked for at
-//!   these plates' 115–190 m/s.
+//!   (`a` is about `m_p/(m_p + m_plug)`: 0.83–0.93 for the 197 g
+//!   projectile and 15–40 g plugs) and `p ≥ 2` under 0.2 % of the limit,
+//!   a fifth of the ±1 m/s a search is asked for at these plates'
+//!   115–230 m/s; the step-like curves near some limits (`p` = 5–6, `a`
+//!   = 0.5–0.8) give far less.
 //! - Otherwise the run ended too early to tell: the projectile is still
 //!   pushed along its flight (or flies free without a plug cut out and
 //!   not yet through, ahead of a plate that may catch it again).
