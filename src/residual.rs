@@ -41,7 +41,8 @@
 //!   [`SLOW_FRACTION`] of the impact speed or below; `v_r = 0`. Such a
 //!   projectile carries at most `SLOW_FRACTION²` (0.25 %) of its impact
 //!   energy. Found on the 12 mm plate at 48 rows (Cockcroft–Latham's
-//!   damage, `docs/validation.md`): held runs crept on at 3–9 m/s
+//!   damage; `docs/validation.md`, "Held runs that creep on with no
+//!   plug"): held runs crept on at 3–9 m/s
 //!   (2–5 % of 183–187 m/s) for 100 µs and more, pushed now and then by
 //!   the bulge, with no plug, until `--max-time` counted them held; at 48
 //!   rows that is an hour or more of a study's time a run. Should such a
