@@ -43,9 +43,10 @@
 //!   energy. Found on the 12 mm plate at 48 rows (Cockcroft–Latham's
 //!   damage; `docs/validation.md`, "Held runs that creep on with no
 //!   plug"): held runs crept on at 3–9 m/s
-//!   (2–5 % of 183–187 m/s) for 100 µs and more, pushed now and then by
-//!   the bulge, with no plug, until `--max-time` counted them held; at 48
-//!   rows that is an hour or more of a study's time a run. Should such a
+//!   (2–5 % of 183–187 m/s), pushed now and then by the bulge, with no
+//!   plug, for 40–55 µs until stopped by hand; such a run went on until
+//!   it stopped (1 %) or to `--max-time`, at 10 s of one core per µs at
+//!   48 rows. Should such a
 //!   run have gone on to cut a plug, the projectile would have left with
 //!   no more than the speed it had, and a Recht–Ipson curve
 //!   `v_r = a (v_iᵖ − v_blᵖ)^(1/p)` puts that run's speed above the limit
