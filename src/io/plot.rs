@@ -266,7 +266,7 @@ fn draw_line_plot(root: &Area, plot: &LinePlot) -> Result<(), String> {
         let samples = plot_samples(plot, ((x0, x1), (y0, y1)));
         chart
             .configure_series_labels()
-            .position(least_covered_corner(&samples, legend).position())
+            .position(least_covered_place(&samples, legend).position())
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .label_font((FONT, 16))
@@ -276,35 +276,53 @@ fn draw_line_plot(root: &Area, plot: &LinePlot) -> Result<(), String> {
     Ok(())
 }
 
-/// A corner of the plot area, where the legend goes.
+/// A place in the plot area for the legend: a corner or the middle of a
+/// side.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Corner {
+enum LegendPlace {
     UpperRight,
     UpperLeft,
     LowerRight,
     LowerLeft,
+    MiddleRight,
+    MiddleLeft,
 }
 
-impl Corner {
+impl LegendPlace {
     /// In order of preference when the data leave more than one free.
-    const ALL: [Corner; 4] = [Corner::UpperRight, Corner::UpperLeft, Corner::LowerRight, Corner::LowerLeft];
+    const ALL: [LegendPlace; 6] = [
+        LegendPlace::UpperRight,
+        LegendPlace::UpperLeft,
+        LegendPlace::LowerRight,
+        LegendPlace::LowerLeft,
+        LegendPlace::MiddleRight,
+        LegendPlace::MiddleLeft,
+    ];
 
     fn position(self) -> SeriesLabelPosition {
         match self {
-            Corner::UpperRight => SeriesLabelPosition::UpperRight,
-            Corner::UpperLeft => SeriesLabelPosition::UpperLeft,
-            Corner::LowerRight => SeriesLabelPosition::LowerRight,
-            Corner::LowerLeft => SeriesLabelPosition::LowerLeft,
+            LegendPlace::UpperRight => SeriesLabelPosition::UpperRight,
+            LegendPlace::UpperLeft => SeriesLabelPosition::UpperLeft,
+            LegendPlace::LowerRight => SeriesLabelPosition::LowerRight,
+            LegendPlace::LowerLeft => SeriesLabelPosition::LowerLeft,
+            LegendPlace::MiddleRight => SeriesLabelPosition::MiddleRight,
+            LegendPlace::MiddleLeft => SeriesLabelPosition::MiddleLeft,
         }
     }
 
     /// Whether `p` (x, y as fractions of the plot area, y up) lies inside
-    /// a box of `size` (width, height fractions) in this corner.
+    /// a box of `size` (width, height fractions) at this place.
     fn covers(self, size: (f64, f64), p: (f64, f64)) -> bool {
-        let right = matches!(self, Corner::UpperRight | Corner::LowerRight);
-        let upper = matches!(self, Corner::UpperRight | Corner::UpperLeft);
-        let in_x = if right { p.0 >= 1.0 - size.0 } else { p.0 <= size.0 };
-        let in_y = if upper { p.1 >= 1.0 - size.1 } else { p.1 <= size.1 };
+        use LegendPlace::*;
+        let in_x = match self {
+            UpperRight | LowerRight | MiddleRight => p.0 >= 1.0 - size.0,
+            UpperLeft | LowerLeft | MiddleLeft => p.0 <= size.0,
+        };
+        let in_y = match self {
+            UpperRight | UpperLeft => p.1 >= 1.0 - size.1,
+            LowerRight | LowerLeft => p.1 <= size.1,
+            MiddleRight | MiddleLeft => (p.1 - 0.5).abs() <= 0.5 * size.1,
+        };
         in_x && in_y
     }
 }
@@ -320,40 +338,73 @@ fn legend_box_fraction(names: &[&str], area: (f64, f64)) -> (f64, f64) {
     ((width / area.0.max(1.0)).min(1.0), (height / area.1.max(1.0)).min(1.0))
 }
 
-/// Where `plot` draws, as fractions of its `ranges` (x, y): every finite
-/// point of every series, 16 points along each segment between them, and
-/// 33 points along each reference line.
+/// Where `plot` draws, as fractions of its `ranges` (x, y): points every
+/// [`SAMPLE_STEP`] along each line (so a line counts by its drawn length,
+/// not by how densely its data were recorded: a history's rows crowd
+/// where the time step is small), [`DOT_WEIGHT`] copies of each lone point
+/// (drawn as a dot), and points every [`SAMPLE_STEP`] along each
+/// reference line.
 fn plot_samples(plot: &LinePlot, ranges: ((f64, f64), (f64, f64))) -> Vec<(f64, f64)> {
     let ((x0, x1), (y0, y1)) = ranges;
     let unit = |p: (f64, f64)| ((p.0 - x0) / (x1 - x0), (p.1 - y0) / (y1 - y0));
     let mut samples = Vec::new();
     for series in &plot.series {
         for run in finite_runs(&series.points) {
-            samples.extend(run.iter().copied().map(unit));
-            for pair in run.windows(2) {
-                let (a, b) = (unit(pair[0]), unit(pair[1]));
-                samples.extend((1..16).map(|k| {
-                    let t = f64::from(k) / 16.0;
-                    (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1))
-                }));
+            let run: Vec<_> = run.into_iter().map(unit).collect();
+            if let [dot] = run[..] {
+                samples.extend(std::iter::repeat_n(dot, DOT_WEIGHT));
             }
+            resample(&run, &mut samples);
         }
     }
     for (_, y) in plot.hlines.iter().filter(|h| h.1.is_finite()) {
         let y = (y.clamp(-AXIS_LIMIT, AXIS_LIMIT) - y0) / (y1 - y0);
-        samples.extend((0..=32).map(|k| (f64::from(k) / 32.0, y)));
+        resample(&[(0.0, y), (1.0, y)], &mut samples);
     }
     samples
 }
 
-/// The corner whose legend box of `size` (fractions of the plot area)
+/// Appends to `samples` the points every [`SAMPLE_STEP`] of length along
+/// the polyline `run`, from its start (none for a single point): however
+/// densely its vertices lie, a stretch counts by its length.
+fn resample(run: &[(f64, f64)], samples: &mut Vec<(f64, f64)>) {
+    let mut to_next = 0.0;
+    for pair in run.windows(2) {
+        let (a, b) = (pair[0], pair[1]);
+        let length = (b.0 - a.0).hypot(b.1 - a.1);
+        if !length.is_finite() {
+            continue;
+        }
+        let mut at = to_next;
+        while at < length && samples.len() < MAX_SAMPLES {
+            let t = at / length;
+            samples.push((a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1)));
+            at += SAMPLE_STEP;
+        }
+        to_next = at - length;
+    }
+}
+
+/// A bound on the samples, for data far outside the range (a line's
+/// length in plot fractions is unbounded there).
+const MAX_SAMPLES: usize = 1_000_000;
+
+/// Spacing of the legend's samples along a drawn line, as a fraction of
+/// the plot area (about 4 px on a default plot).
+const SAMPLE_STEP: f64 = 0.005;
+
+/// A lone point (a dot: an experiment, one run) counts as this many
+/// samples, as much as a line across a tenth of the plot.
+const DOT_WEIGHT: usize = 20;
+
+/// The place whose legend box of `size` (fractions of the plot area)
 /// covers the fewest of `samples` (fractions, y up): the first of
-/// [`Corner::ALL`] among equals, upper right when nothing is drawn. A
+/// [`LegendPlace::ALL`] among equals, upper right when nothing is drawn. A
 /// ballistic curve rises to the upper right, where a fixed legend hid its
 /// fastest runs and the experiments beside them.
-fn least_covered_corner(samples: &[(f64, f64)], size: (f64, f64)) -> Corner {
-    let covered = |corner: Corner| samples.iter().filter(|p| corner.covers(size, **p)).count();
-    Corner::ALL.into_iter().min_by_key(|c| covered(*c)).unwrap_or(Corner::UpperRight)
+fn least_covered_place(samples: &[(f64, f64)], size: (f64, f64)) -> LegendPlace {
+    let covered = |place: LegendPlace| samples.iter().filter(|p| place.covers(size, **p)).count();
+    LegendPlace::ALL.into_iter().min_by_key(|c| covered(*c)).unwrap_or(LegendPlace::UpperRight)
 }
 
 /// Width of the colour-bar strip at the right of a field plot, pixels.
@@ -693,7 +744,7 @@ mod tests {
     }
 
     #[test]
-    fn the_legend_takes_the_corner_the_data_leave_free() {
+    fn the_legend_takes_the_place_the_data_leave_free() {
         let size = (0.4, 0.2);
         // A ballistic curve: held runs along the bottom, then rising to
         // the upper right; the upper left is free.
@@ -706,18 +757,56 @@ mod tests {
         };
         let samples = plot_samples(&curve, ((75.0, 310.0), (-10.0, 260.0)));
         assert!(samples.iter().all(|p| (0.0..=1.0).contains(&p.0) && (0.0..=1.0).contains(&p.1)));
-        assert_eq!(least_covered_corner(&samples, size), Corner::UpperLeft);
+        assert_eq!(least_covered_place(&samples, size), LegendPlace::UpperLeft);
         // A decaying history fills the upper left and the bottom; the upper
         // right is free and stays preferred.
         let samples = plot_samples(&sample_line_plot(), ((0.0, 20.0), (-15.0, 315.0)));
-        assert_eq!(least_covered_corner(&samples, size), Corner::UpperRight);
+        assert_eq!(least_covered_place(&samples, size), LegendPlace::UpperRight);
         // One point in each upper corner, none below: the lower right.
-        assert_eq!(least_covered_corner(&[(0.95, 0.95), (0.05, 0.95)], size), Corner::LowerRight);
-        assert_eq!(least_covered_corner(&[], size), Corner::UpperRight);
+        assert_eq!(least_covered_place(&[(0.95, 0.95), (0.05, 0.95)], size), LegendPlace::LowerRight);
+        assert_eq!(least_covered_place(&[], size), LegendPlace::UpperRight);
         // A reference line across the top counts in both upper corners.
         let hline = LinePlot { hlines: vec![("limit".into(), 0.95)], ..LinePlot::default() };
         let samples = plot_samples(&hline, ((0.0, 1.0), (0.0, 1.0)));
-        assert_eq!(least_covered_corner(&samples, size), Corner::LowerRight);
+        assert_eq!(least_covered_place(&samples, size), LegendPlace::LowerRight);
+        // An energy history: a constant total along the top, recorded
+        // ever more densely to the right (a shrinking time step), and the
+        // projectile's energy falling from the top at the left, two
+        // sparse lines along the bottom. Each line counts by its length,
+        // so the upper right is the freest; counted by points, the dense
+        // total would have sent the legend down over the two.
+        let crowded: Vec<(f64, f64)> = (0..=400).map(|k| (1.0 - (1.0 - k as f64 / 400.0).powi(3), 1.0)).collect();
+        let energy = LinePlot {
+            series: vec![
+                Series { name: "total".into(), points: crowded },
+                Series { name: "projectile".into(), points: vec![(0.0, 1.0), (0.05, 0.5), (1.0, 0.5)] },
+                Series { name: "kinetic".into(), points: vec![(0.0, 0.0), (1.0, 0.1)] },
+                Series { name: "internal".into(), points: vec![(0.0, 0.0), (1.0, 0.15)] },
+            ],
+            ..LinePlot::default()
+        };
+        let samples = plot_samples(&energy, ((-0.05, 1.05), (-0.05, 1.05)));
+        assert_eq!(least_covered_place(&samples, (0.4, 0.2)), LegendPlace::UpperRight);
+        // With the middle free of lines, the middle of a side: nothing hidden.
+        let mut energy = energy;
+        energy.series[1].points = vec![(0.0, 1.0), (0.05, 0.9), (1.0, 0.9)];
+        let samples = plot_samples(&energy, ((-0.05, 1.05), (-0.05, 1.05)));
+        assert_eq!(least_covered_place(&samples, (0.4, 0.2)), LegendPlace::MiddleRight);
+        // A lone point (an experiment) outweighs a short stretch of line.
+        let dot = LinePlot {
+            series: vec![
+                Series { name: "a".into(), points: vec![(0.9, 0.9)] },
+                Series { name: "b".into(), points: vec![(0.0, 0.9), (0.05, 0.9)] },
+            ],
+            ..LinePlot::default()
+        };
+        let samples = plot_samples(&dot, ((0.0, 1.0), (0.0, 1.0)));
+        assert_eq!(least_covered_place(&samples, size), LegendPlace::LowerRight);
+        let only_line = LinePlot { series: vec![dot.series[1].clone()], ..LinePlot::default() };
+        assert_eq!(
+            least_covered_place(&plot_samples(&only_line, ((0.0, 1.0), (0.0, 1.0))), size),
+            LegendPlace::UpperRight
+        );
         // The box grows with the longest entry and the number of entries.
         let (w1, h1) = legend_box_fraction(&["a"], (800.0, 500.0));
         let (w2, h2) = legend_box_fraction(&["a", "Recht-Ipson a = 0.843, p = 3.20"], (800.0, 500.0));
