@@ -1248,7 +1248,8 @@ one target thickness past the target's far face) and the contact force along \
 that direction (`NAME_f_axial` in each run's `history.csv`) has stayed below 0.1 % of its peak for at least \
 1 us; a touch on the side wall of the hole pushes across the flight and does not count. Held: the \
 projectile's speed along its flight fell to 1 % of the impact speed or below (stopped or bounced back), \
-or to 5 % or below with no plug cut out (at most 0.25 % of its energy left): v_r = 0. Each run stops 20 us after either (`time.stop_after_release`); one still undecided at the case's \
+or to 5 % or below with no plug cut out (at most 0.25 % of its energy left): v_r = 0. Each run stops 20 us \
+after either (`time.stop_after_release`); one still undecided at the case's \
 end time goes on, up to `--max-time` (default 3 times the case's end time). A run still undecided at its end \
 counts as perforating if a plug was cut out, else as held. Ballistic limit: \
 between the lowest perforating speed and the highest speed held below it (one held above it marks a zone of \

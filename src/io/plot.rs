@@ -385,8 +385,8 @@ fn resample(run: &[(f64, f64)], samples: &mut Vec<(f64, f64)>) {
     }
 }
 
-/// A bound on the samples, for data far outside the range (a line's
-/// length in plot fractions is unbounded there).
+/// A bound on the samples: a long history that swings up and down every
+/// row draws a line many plot-widths long.
 const MAX_SAMPLES: usize = 1_000_000;
 
 /// Spacing of the legend's samples along a drawn line, as a fraction of
