@@ -251,7 +251,7 @@ pub fn verdict(
         return Verdict::Undecided { speed: impact_speed, plug, free: false };
     };
     let plug = plug || is_through(position, through);
-    // Without a plug the slow run, which holds the stopped one
+    // Without a plug the slow run decides: it contains the stopped one
     // (`STOP_FRACTION < SLOW_FRACTION`) and started first.
     let held = if plug { tracker.stopped_since } else { tracker.slow_since };
     if let Some(since) = held {
