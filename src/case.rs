@@ -10,6 +10,7 @@ use crate::contact::{
     mass_axisymmetric, mass_plane_strain, rectangle_outline, ContactError, NoseShape, Projectile, RigidBody,
 };
 use crate::discretize::RectangleGrid;
+use crate::fracture::{Criterion, FractureParameters};
 use crate::geometry::GeometryMode;
 use crate::material::{Constitutive, Elastic, JohnsonCook, Material, ThermalProperties};
 use crate::math::{Real, Vec2};
@@ -44,9 +45,11 @@ pub struct Case {
     /// Heat conduction (SPEC §7).
     #[serde(default)]
     pub heat: HeatSpec,
-    /// Crack growth (SPEC §9). Default: no cracks.
+    /// Crack growth (SPEC §9). Default: the default model
+    /// ([`FractureParameters::default`]); a material without a damage locus
+    /// never cracks.
     #[serde(default)]
-    pub fracture: crate::fracture::FractureParameters,
+    pub fracture: FractureParameters,
     /// Time integration.
     pub time: TimeSpec,
     /// Output.
@@ -618,6 +621,7 @@ impl Case {
                 message,
             })?;
         }
+        fill_criterion_defaults(&mut table);
         let case: Case = table.try_into().map_err(|e: toml::de::Error| CaseError::Parse {
             file: file.to_string(),
             message: toml_message(&e, None),
@@ -1056,7 +1060,7 @@ impl Case {
     pub fn has_contact(&self) -> bool {
         !self.rigid_bodies.is_empty()
             || (self.contact.deformable && self.bodies.len() > 1)
-            || (self.contact.self_contact && self.fracture.criterion != crate::fracture::Criterion::None)
+            || (self.contact.self_contact && self.fracture.criterion != Criterion::None)
     }
 
     /// The artificial bulk viscosity ([`crate::bulk_viscosity`]; none
@@ -1202,6 +1206,29 @@ fn validate_grid(add: &mut impl FnMut(String, String), key: &str, g: &RectangleG
                     g.fine_half_width
                 ),
             );
+        }
+    }
+}
+
+/// Gives `[fracture]` the defaults of its criterion where the case leaves
+/// them out ([`FractureParameters::CRITERION_DEFAULTS`],
+/// [`FractureParameters::for_criterion`]): the default model's tip rule
+/// under `"nonlocal_damage"`, SPEC §9's under \[RL10\]'s criteria. Runs
+/// after the `--set` overrides, so `--set fracture.criterion=damage` on a
+/// default-model case gives the paper's tip as well. A criterion that does
+/// not parse is left to the parse's own error.
+fn fill_criterion_defaults(table: &mut toml::Table) {
+    let Some(fracture) = table.get_mut("fracture").and_then(toml::Value::as_table_mut) else {
+        return;
+    };
+    let Some(Ok(criterion)) = fracture.get("criterion").map(|c| c.clone().try_into::<Criterion>()) else {
+        return;
+    };
+    let defaults = toml::Table::try_from(FractureParameters::for_criterion(criterion))
+        .expect("fracture parameters serialize to a table");
+    for key in FractureParameters::CRITERION_DEFAULTS {
+        if !fracture.contains_key(key) {
+            fracture.insert(key.to_string(), defaults[key].clone());
         }
     }
 }

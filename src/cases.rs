@@ -266,6 +266,9 @@ pub const ALIASES: &[(&str, &str)] = &[("borvik-1", "borvik-1-plane-strain"), ("
 pub const MATERIAL_RL10: &str = "weldox_460e";
 /// Børvik et al.'s modified fit of the same steel (power rate law).
 pub const MATERIAL_MODIFIED: &str = "weldox_460e_borvik";
+/// The default model's material: \[RL10\]'s steel with Cockcroft–Latham
+/// damage (`crate::fracture`, "The default model's tip and damage").
+pub const MATERIAL_DEFAULT_MODEL: &str = "weldox_460e_cockcroft_latham";
 
 /// One member of Børvik's reference family: which experiment, geometry,
 /// discretization, criterion and material a built-in case stands for.
@@ -278,10 +281,12 @@ pub struct BorvikCase {
     /// `"coarse"` (24 rows) or `"fine"` (48 rows).
     pub discretization: &'static str,
     /// `"effective_strain"` or `"damage"` (\[RL10\]'s, the paper's mode), or
-    /// `"nonlocal_damage"` (the default model, axisymmetric with \[RL10\]'s
+    /// `"nonlocal_damage"` (the default model, axisymmetric with its own
     /// material only).
     pub criterion: &'static str,
-    /// The built-in material: [`MATERIAL_RL10`] or [`MATERIAL_MODIFIED`].
+    /// The built-in material: [`MATERIAL_RL10`] or [`MATERIAL_MODIFIED`]
+    /// with \[RL10\]'s criteria, [`MATERIAL_DEFAULT_MODEL`] with the
+    /// default model.
     pub material: &'static str,
 }
 
@@ -326,7 +331,7 @@ impl BorvikCase {
 /// per case, both geometries × both discretizations × both of \[RL10\]'s
 /// criteria with its material, the axisymmetric fine cases with Børvik's
 /// modified material (both criteria), then the axisymmetric cases with the
-/// default fracture model (coarse and fine): 24 cases.
+/// default fracture model and its material (coarse and fine): 24 cases.
 pub fn borvik_family() -> Vec<BorvikCase> {
     let mut v = Vec::new();
     for experiment in [1, 2] {
@@ -352,7 +357,7 @@ pub fn borvik_family() -> Vec<BorvikCase> {
                 geometry: "axisymmetric",
                 discretization,
                 criterion: "nonlocal_damage",
-                material: MATERIAL_RL10,
+                material: MATERIAL_DEFAULT_MODEL,
             });
         }
     }

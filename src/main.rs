@@ -860,8 +860,9 @@ fn one_study(
                 eprintln!("[{at:6.0} s] {label}: {} m/s", v.join(", "));
             }
             Event::Started { speed } => eprintln!("[{at:6.0} s]   {speed:.2} m/s started"),
-            Event::Advanced { speed, time, end } => {
-                eprintln!("[{at:6.0} s]   {speed:.2} m/s at {:.1} of {:.1} us", time * 1e6, end * 1e6)
+            Event::Advanced { speed, time, end, along } => {
+                let along = along.map(|v| format!(", projectile at {v:.1} m/s")).unwrap_or_default();
+                eprintln!("[{at:6.0} s]   {speed:.2} m/s at {:.1} of {:.1} us{along}", time * 1e6, end * 1e6)
             }
             Event::Finished { shot } => eprintln!(
                 "[{at:6.0} s]   {:.2} m/s: {}{} ({:.1} s)",

@@ -68,7 +68,7 @@ pub const HISTORY_COLUMNS: &[&str] = &[
 /// split particle (left child), the new right child and, for nucleate and
 /// propagate, the new tip, separated by spaces; `value` is the criterion
 /// value of the new tip (of the split tip at arrest; empty for an inserted
-/// pre-crack), `damage` that particle's own Johnson–Cook damage
+/// pre-crack), `damage` that particle's own damage (the material's law)
 /// ([`crate::fracture::CrackEvent::damage`]; empty likewise) and
 /// `hardening` its adiabatic hardening, ≤ 0 past the onset of shear
 /// localization ([`crate::fracture::CrackEvent::hardening`]; empty likewise
@@ -781,7 +781,7 @@ pub fn field_plot(sim: &Simulation, field: &str, window: Option<[Real; 4]>) -> O
         ),
         "temperature" => (m.project(|k| q.temperature[k]), "temperature (K)", None),
         "plastic_strain" => (m.project(|k| q.eps_p[k]), "effective plastic strain", Some(0.0)),
-        "damage" => (m.project(|k| q.damage[k]), "Johnson-Cook damage", Some(0.0)),
+        "damage" => (m.project(|k| q.damage[k]), "damage D", Some(0.0)),
         _ => return None,
     };
     let u = m.physical(&m.particles.u);

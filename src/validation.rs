@@ -254,13 +254,13 @@ pub fn run_row_with(row: &Row, dir: &Path, full_time: bool, extra: &[String]) ->
 /// the fine case (48 rows). Nothing else changes.
 pub const LADDER: [usize; 3] = [12, 24, 48];
 
-/// The convergence study's rows: every coarse axisymmetric member with
-/// \[RL10\]'s material (both experiments; the default model and
-/// \[RL10\]'s two criteria), each the 24-row rung of its ladder.
+/// The convergence study's rows: every coarse axisymmetric member
+/// (both experiments; the default model and \[RL10\]'s two criteria with
+/// \[RL10\]'s material), each the 24-row rung of its ladder.
 pub fn convergence_rows() -> Vec<Row> {
     coarse_rows()
         .into_iter()
-        .filter(|r| r.case.geometry == "axisymmetric" && r.case.material == crate::cases::MATERIAL_RL10)
+        .filter(|r| r.case.geometry == "axisymmetric" && r.case.material != crate::cases::MATERIAL_MODIFIED)
         .collect()
 }
 
@@ -382,10 +382,10 @@ fn fmt_csv(v: Option<Real>, digits: usize) -> String {
 
 /// Short name of a row's material.
 fn material_label(case: &BorvikCase) -> &'static str {
-    if case.material == crate::cases::MATERIAL_MODIFIED {
-        "modified"
-    } else {
-        "RL10"
+    match case.material {
+        crate::cases::MATERIAL_MODIFIED => "modified",
+        crate::cases::MATERIAL_DEFAULT_MODEL => "RL10 Cockcroft–Latham",
+        _ => "RL10",
     }
 }
 

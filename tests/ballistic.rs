@@ -502,13 +502,19 @@ fn a_resumed_study_continues_the_interrupted_runs_and_takes_back_the_finished() 
     let flag = Arc::new(AtomicBool::new(false));
     s.interrupt = Some(flag.clone());
     let mut study = Study::default();
+    let mut reported = None;
     run_speeds(&s, &[speed], &mut study, &mut |_| Ok(()), &mut |e| {
-        if matches!(e, Event::Advanced { .. }) {
+        if let Event::Advanced { along, .. } = e {
+            reported.get_or_insert(along);
             flag.store(true, Ordering::SeqCst);
         }
     })
     .unwrap();
     assert!(study.interrupted && study.shots.is_empty());
+    // the report carries the projectile's speed along its flight: slowed
+    // by the plate at 4 us, still moving on
+    let along = reported.flatten().expect("the projectile's speed in the progress report");
+    assert!(along > 0.5 * speed && along < speed, "{along} m/s at 4 us of a {speed} m/s impact");
     let dir = plugsim::ballistic::run_dir(&s.out_dir, speed);
     assert!(!dir.join(plugsim::ballistic::SHOT_FILE).exists());
 

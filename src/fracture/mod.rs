@@ -309,8 +309,10 @@
 //!   (`contact.self_contact`) is off: it lowers Case II to 118 m/s at 24
 //!   rows but throws particles at up to 1.9 km/s.
 //!
-//!   What it does not do yet (`docs/validation.md`, "Ballistic limits"
-//!   and "Why the limits are low"): its ballistic limits are low, flat in
+//!   What it did not do with \[RL10\]'s Johnson–Cook locus and the most
+//!   damaged tip (the default until 2026-11-30; `docs/validation.md`,
+//!   "Ballistic limits" and "Why the limits are low"; what replaced them:
+//!   "The default model's tip and damage" below): its ballistic limits were low, flat in
 //!   the thickness and not converged — Case I's plate 124.9, 122.1,
 //!   115.0 m/s at 12, 24, 48 rows, Børvik's 12 mm plate 125.7 m/s at 24
 //!   rows against the published 184.5. The cause is measured: near the
@@ -354,8 +356,49 @@
 //!   as it is. Tests: `nonlocal_criterion_switches` (below),
 //!   `tests/fracture.rs` (the average, the band, the speed limit, torn
 //!   points), `plugsim validate --family convergence`.
-//! - **The tip's direction** (`tip_direction`; an option, tried for issue
-//!   #19 and not the default). \[RL10\]'s tip steps to the candidate with
+//! - **The default model's tip and damage (issue #19, 2026-11-30).** The
+//!   band criterion above is the default model's; with it the tip steps
+//!   along the velocity jump (`tip_direction = "velocity_jump"`, "The
+//!   tip's direction" below) and its compression gate reads the
+//!   triaxiality over `ℓ` (`nonlocal_tip_triaxiality = true`, "The
+//!   compression gate on the tip" below): those are the defaults under
+//!   `"nonlocal_damage"` ([`FractureParameters::for_criterion`]), while
+//!   \[RL10\]'s criteria keep SPEC §9's most-damaged rule and the
+//!   particle's own gate, so the paper's mode keeps its bits. The damage
+//!   itself is the material's: the built-in default-model cases give the
+//!   plate `weldox_460e_cockcroft_latham`, Cockcroft–Latham's damage with
+//!   its one constant from a tension test on \[RL10\]'s hardening curve
+//!   (`crate::material::johnson_cook`, Deviation 15), where they gave it
+//!   \[RL10\]'s Johnson–Cook locus before. Why (measured,
+//!   `docs/validation.md`, "The default model and the Cockcroft–Latham
+//!   candidate, target by target"): the Johnson–Cook locus with the most
+//!   damaged tip put Børvik's 12 mm blunt limit at 116.75–125.50 m/s
+//!   (published 184.5, −32…−37 %) and cut Case I's plug at 15–19 µs
+//!   (\[RL10\]: 28); this model gives 184.50 / 189.50 / 189.50 m/s at 24 /
+//!   48 / 72 rows (2.7 %), Case I's residual within −2.8…−3.4 % at 48 and
+//!   96 rows with the plug cut at 27–30 µs, and it brackets the
+//!   hemispherical nose's tests. It misses Case II's test (the plate's
+//!   limit sits at the test's speed, 169.75–175.85 m/s at 12–48 rows,
+//!   where the test left 112 m/s) by more than the earlier model did, and
+//!   the hemispherical nose's residual does not converge; the report says
+//!   so. The 12 mm test is the one this model was chosen on (it was tried
+//!   because the earlier one missed it), so that match is not a blind
+//!   prediction; `W_c` was fixed from the tension test before any run and
+//!   not moved. The earlier default is three `--set`s away
+//!   (`bodies.plate.material=weldox_460e`,
+//!   `fracture.tip_direction=most_damaged`,
+//!   `fracture.nonlocal_tip_triaxiality=false`). In 3D the ingredients
+//!   carry over as they are: `σ₁` and `ε̄` are invariants, the velocity
+//!   jump is the plane of largest sliding rate of `Ḟ` over a ball, and the
+//!   gate is the same ratio over that ball. Tests:
+//!   `the_defaults_follow_the_criterion` (below),
+//!   `tests/fracture.rs::crack_follows_the_velocity_jump`,
+//!   `the_tip_gate_over_a_length`, the Cockcroft–Latham tests of
+//!   `crate::material::johnson_cook`, and
+//!   `tests/case_files.rs::a_case_without_the_tip_fields_gets_its_criterions`.
+//! - **The tip's direction** (`tip_direction`; tried for issue #19, the
+//!   velocity jump the default model's since 2026-11-30, the paragraph
+//!   above). \[RL10\]'s tip steps to the candidate with
 //!   the largest criterion value (with `"nonlocal_damage"` the largest own
 //!   damage, `CrackGrowth::path_value`), a choice between lattice
 //!   particles. `"max_shear"` steps instead to the candidate nearest in
@@ -509,14 +552,14 @@ pub enum Criterion {
 
 /// Which candidate a growing crack tip (or a nucleating core) steps to,
 /// among those that meet the criterion (module doc, "The tip's
-/// direction").
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+/// direction"). The default depends on the criterion
+/// ([`FractureParameters::for_criterion`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum TipDirection {
     /// The most damaged one: the largest criterion value (\[RL10\]'s rule,
     /// SPEC §9), with `"nonlocal_damage"` the largest own damage
-    /// (`CrackGrowth::path_value`). The default.
-    #[default]
+    /// (`CrackGrowth::path_value`). The default with \[RL10\]'s criteria.
     MostDamaged,
     /// The one nearest in angle to the slip line through the tip: the
     /// in-plane direction of maximum shear stress, pulled back to the
@@ -530,7 +573,8 @@ pub enum TipDirection {
     /// summed over the ball of radius `ℓ`
     /// ([`geometry::velocity_jump_direction`]), aimed at its centre line
     /// one `ℓ` ahead ([`geometry::band_aim`]); a kinematic,
-    /// lattice-independent direction (issue #19, optional).
+    /// lattice-independent direction (issue #19). The default with
+    /// `"nonlocal_damage"`.
     VelocityJump,
 }
 
@@ -614,10 +658,13 @@ pub struct FractureParameters {
     /// of inverted failed points"). Default true; false stops the run at
     /// the first inverted point, failed or not.
     pub erode_inverted: bool,
-    /// Which candidate the tip steps to: `"most_damaged"` (the default,
-    /// \[RL10\]'s rule), `"max_shear"` (the one nearest to the slip line
-    /// through the tip) or `"velocity_jump"` (the one nearest to where the
-    /// band across which the velocity jumps leads; [`TipDirection`]).
+    /// Which candidate the tip steps to: `"most_damaged"` (\[RL10\]'s
+    /// rule), `"max_shear"` (the one nearest to the slip line through the
+    /// tip) or `"velocity_jump"` (the one nearest to where the band across
+    /// which the velocity jumps leads; [`TipDirection`]). Default
+    /// `"velocity_jump"` with `"nonlocal_damage"` (the default model),
+    /// `"most_damaged"` with \[RL10\]'s criteria (the paper's mode;
+    /// [`Self::for_criterion`]).
     pub tip_direction: TipDirection,
     /// A growing tip steps only to a candidate whose stress triaxiality
     /// `σ_m/σ_eq` is at least this, dimensionless, in [−10, 0] (a join to
@@ -630,7 +677,9 @@ pub struct FractureParameters {
     /// reads the triaxiality averaged over `nonlocal_radius` (the ratio of
     /// the averaged mean and von Mises stresses, the ball and weights of
     /// the damage average) instead of the candidate particle's own.
-    /// Default false (module doc, "The compression gate on the tip").
+    /// Default true with `"nonlocal_damage"` (the default model), false
+    /// with \[RL10\]'s criteria (the paper's mode; [`Self::for_criterion`];
+    /// module doc, "The compression gate on the tip").
     pub nonlocal_tip_triaxiality: bool,
     /// With `"nonlocal_damage"`: the weight of the average over the
     /// section, `"disc"` (the bell `(1 − r²/ℓ²)²`, the default) or
@@ -649,9 +698,28 @@ pub struct FractureParameters {
 }
 
 impl Default for FractureParameters {
+    /// The default model's: [`Self::for_criterion`] of `"nonlocal_damage"`.
     fn default() -> Self {
+        FractureParameters::for_criterion(Criterion::NonlocalDamage)
+    }
+}
+
+impl FractureParameters {
+    /// The fields whose default depends on the criterion
+    /// ([`Self::for_criterion`]); a case file that leaves them out gets its
+    /// criterion's (`crate::case::Case::from_str_with`).
+    pub const CRITERION_DEFAULTS: [&'static str; 2] = ["tip_direction", "nonlocal_tip_triaxiality"];
+
+    /// The defaults under `criterion`. The crack tip's rule is part of the
+    /// model: the default model (`"nonlocal_damage"`) steps along the
+    /// velocity jump with its compression gate read over `ℓ` (module doc,
+    /// "The default model's tip"), \[RL10\]'s criteria (the paper's mode)
+    /// step to the most damaged candidate with the particle's own gate, as
+    /// SPEC §9 does. Everything else is the same for every criterion.
+    pub fn for_criterion(criterion: Criterion) -> Self {
+        let band_model = criterion == Criterion::NonlocalDamage;
         FractureParameters {
-            criterion: Criterion::NonlocalDamage,
+            criterion,
             nonlocal_radius: 1.0e-3,
             crack_speed_fraction: 1.0,
             nonlocal_point_fracture: true,
@@ -663,16 +731,14 @@ impl Default for FractureParameters {
             offset_ratio: 0.01,
             nucleation_distance_factor: 10.0,
             erode_inverted: true,
-            tip_direction: TipDirection::MostDamaged,
+            tip_direction: if band_model { TipDirection::VelocityJump } else { TipDirection::MostDamaged },
             tip_min_triaxiality: growth::NUCLEATION_MIN_TRIAXIALITY,
-            nonlocal_tip_triaxiality: false,
+            nonlocal_tip_triaxiality: band_model,
             nonlocal_weight: NonlocalWeight::Disc,
             detach_below: 0.0,
         }
     }
-}
 
-impl FractureParameters {
     /// Problems with the parameters as `(key, message)`, keys relative to
     /// the `[fracture]` section.
     pub fn problems(&self) -> Vec<(&'static str, String)> {
@@ -819,5 +885,27 @@ mod tests {
         let c = nl.max_tip_speed(80e9, 160e9, 7850.0).unwrap();
         assert!(c > 0.87 * (80e9 / 7850.0_f64).sqrt() && c < (80e9 / 7850.0_f64).sqrt(), "{c}");
         assert_eq!(FractureParameters { crack_speed_fraction: 0.0, ..nl }.max_tip_speed(80e9, 160e9, 7850.0), None);
+    }
+
+    /// The default model's tip (the velocity jump, the gate over `ℓ`)
+    /// under `"nonlocal_damage"`; SPEC §9's (the most damaged candidate,
+    /// the particle's own gate) under \[RL10\]'s criteria; nothing else
+    /// differs between criteria.
+    #[test]
+    fn the_defaults_follow_the_criterion() {
+        let d = FractureParameters::default();
+        assert_eq!(d, FractureParameters::for_criterion(Criterion::NonlocalDamage));
+        assert_eq!((d.tip_direction, d.nonlocal_tip_triaxiality), (TipDirection::VelocityJump, true));
+        for c in [Criterion::EffectiveStrain, Criterion::Damage, Criterion::None] {
+            let p = FractureParameters::for_criterion(c);
+            assert_eq!((p.tip_direction, p.nonlocal_tip_triaxiality), (TipDirection::MostDamaged, false), "{c:?}");
+            let same = FractureParameters {
+                criterion: d.criterion,
+                tip_direction: d.tip_direction,
+                nonlocal_tip_triaxiality: true,
+                ..p
+            };
+            assert_eq!(same, d, "{c:?}: only the tip's fields differ");
+        }
     }
 }

@@ -161,7 +161,9 @@
 //!     (`σ*` is the same invariant there). Tests:
 //!     `the_cut_off_stops_damage_below_it_only`,
 //!     `tests/material.rs::upsetting_accrues_no_damage_below_the_cut_off`.
-//! 15. **Cockcroft–Latham damage (optional, beyond \[RL10\]).** With
+//! 15. **Cockcroft–Latham damage (beyond \[RL10\]; the plate's damage in
+//!     the built-in default-model cases since 2026-11-30, `crate::fracture`,
+//!     "The default model's tip and damage").** With
 //!     `damage.cockcroft_latham = W_c` the damage grows as
 //!     `dD = ⟨σ₁⟩ dε̄ / W_c` (Cockcroft & Latham, J. Inst. Metals 96 (1968)
 //!     33), `σ₁` the largest principal stress (of `τ`: `J ≈ 1` in plastic
