@@ -1165,9 +1165,11 @@ pub const GUIDED_HALF_WIDTH: Real = 0.9;
 /// `study` (with its Recht–Ipson fit, [`refit`]), the bracket `(lo, hi)`
 /// they give (held at `lo`, perforated at `hi`), the tolerance and the runs
 /// side by side: `jobs` speeds spread over `v_bl ± GUIDED_HALF_WIDTH·tol`
-/// around the fit's `v_bl` (kept that far inside the bracket) when the fit
-/// has its exponent free (three perforating runs or more) and the search
-/// has not run such a round yet (`guided`); else `jobs` speeds evenly
+/// around the fit's `v_bl` when the fit has its exponent free (three
+/// perforating runs or more), its `v_bl` lies more than that inside the
+/// bracket (a fit held at the edge of its range, the highest held speed,
+/// fits no curve), and the search has not run such a round yet
+/// (`guided`); else `jobs` speeds evenly
 /// spaced inside the bracket (two split it in three). Above the limit the
 /// residual follows Recht and Ipson's curve closely (rms 0.02 m/s over
 /// four runs of Case I's plate, docs/validation.md), so a fit right to
@@ -1189,11 +1191,13 @@ pub fn next_round(
     let (Some(fit), false) = (fit, guided) else {
         return (even(), None);
     };
+    // a fit whose v_bl sits at the edge of its range (the held speed) or
+    // outside the bracket knows no better than the even split
     let (half, margin) = (GUIDED_HALF_WIDTH * tol, 0.01);
-    if hi - lo <= 2.0 * (half + margin) {
+    let centre = fit.v_bl;
+    if !(centre - half - margin > lo && centre + half + margin < hi) {
         return (even(), None);
     }
-    let centre = fit.v_bl.clamp(lo + half + margin, hi - half - margin);
     let speeds: Vec<Real> = match n {
         1 => vec![round(centre)],
         _ => (0..n).map(|k| round(centre - half + 2.0 * half * k as Real / (n - 1) as Real)).collect(),
@@ -2111,9 +2115,9 @@ mod tests {
         // three runs side by side: the fit's v_bl and 0.9 tol either side
         let (three, _) = next_round(&study, (149.0, 198.67), 1.0, 3, false);
         assert!((three[1] - guess).abs() < 0.006 && (three[2] - three[0] - 1.8).abs() < 0.011, "{three:?}");
-        // a guess outside the bracket is kept 0.9 tol inside it
-        let (inside, _) = next_round(&study, (120.0, 150.0), 1.0, 2, false);
-        assert_eq!(inside, vec![148.19, 149.99]);
+        // a guess outside the bracket, or within 0.9 tol of its edge: the even split
+        assert_eq!(next_round(&study, (120.0, 150.0), 1.0, 2, false), (vec![130.0, 140.0], None));
+        assert_eq!(next_round(&study, (180.5, 198.67), 1.0, 2, false).1, None);
         // two perforating runs: p held at 2, no guidance
         study.shots.pop();
         refit(&mut study);
