@@ -629,7 +629,8 @@ pub enum Event {
     /// A run started.
     Started { speed: Real },
     /// A run reached `time` of at most `end` (s): at every 10 % of `end`,
-    /// and at least every [`PROGRESS_WALL_INTERVAL`] of wall time; `along`
+    /// and at the first step report (1/200 of the run's estimated steps)
+    /// after each [`PROGRESS_WALL_INTERVAL`] of wall time; `along`
     /// is the projectile's speed along its flight then (m/s; the history's
     /// sample, [`flight_speed`]).
     Advanced { speed: Real, time: Real, end: Real, along: Option<Real> },
@@ -948,9 +949,9 @@ pub fn finished_run(setup: &Setup, speed: Real) -> Option<(Shot, Option<String>)
     Some((Shot { dir, ..run.shot }, note))
 }
 
-/// The longest wall time between two progress reports of a run
-/// ([`Event::Advanced`]): a 72-row run takes tens of minutes per 10 % of
-/// its end time.
+/// The wall time after which a run reports its progress at its next step
+/// report even between two 10 % marks ([`Event::Advanced`]): a 72-row run
+/// takes tens of minutes per 10 % of its end time.
 pub const PROGRESS_WALL_INTERVAL: std::time::Duration = std::time::Duration::from_secs(120);
 
 /// The speed of `projectile` (named `name`) along its flight direction
