@@ -2,7 +2,8 @@
 //! velocity every run reports (`plugsim::residual`).
 
 use plugsim::ballistic::{
-    at_rows, at_speed, find_limit, flight, run_speeds, select_projectile, write_files, Event, Projectile, Setup, Study,
+    at_rows, at_speed, find_limit, flight, flight_speed, run_speeds, select_projectile, write_files, Event, Projectile,
+    Setup, Study,
 };
 use plugsim::case::Case;
 use plugsim::residual::Verdict;
@@ -454,6 +455,18 @@ fn a_study_fires_a_deformable_projectile() {
         interrupt: None,
         resume: false,
     };
+    // what the progress reports give of it: its mass-averaged speed along
+    // its flight, the impact speed at the start, slowed by the plate after
+    let mut sim = plugsim::run::build_simulation(&s.case).unwrap();
+    let (direction, impact) = flight(&s.case, projectile);
+    let name = projectile.name(&s.case).to_string();
+    let at_start = flight_speed(&sim, projectile, &name, &direction).unwrap();
+    assert!((at_start - impact).abs() < 1e-9 * impact, "{at_start} against {impact}");
+    while sim.time < 5e-6 {
+        sim.step().unwrap();
+    }
+    let later = flight_speed(&sim, projectile, &name, &direction).unwrap();
+    assert!(later > 0.5 * impact && later < impact, "{later} m/s at 5 us of {impact}");
     let mut study = Study::default();
     run_speeds(&s, &[500.0], &mut study, &mut |_| Ok(()), &mut |_| {}).unwrap();
     assert_eq!(study.shots.len(), 1, "{:?}", study.failures);
