@@ -956,17 +956,14 @@ pub const PROGRESS_WALL_INTERVAL: std::time::Duration = std::time::Duration::fro
 
 /// The speed of `projectile` (named `name`) along its flight direction
 /// `dir` in `sim`, m/s: a rigid body's, or a deformable one's
-/// mass-averaged velocity, as the history samples them
-/// (`crate::output`); `None` where the body is not found.
+/// mass-averaged velocity, the history's sample
+/// ([`crate::output::flight_sample`]); `None` where the body is not found.
 pub fn flight_speed(sim: &crate::step::Simulation, projectile: Projectile, name: &str, dir: &Vec2) -> Option<Real> {
-    let sample = match projectile {
-        Projectile::Rigid(k) => sim.contact.as_ref()?.sample(k)?,
-        Projectile::Deformable(_) => {
-            let body = sim.model.bodies.iter().position(|b| b.name == name)? as u32;
-            crate::contact::deformable_sample(&sim.model.particles, &sim.f_contact, body, sim.contact.as_ref())
-        }
+    let rigid = match projectile {
+        Projectile::Rigid(k) => Some(k),
+        Projectile::Deformable(_) => None,
     };
-    Some(sample.velocity.dot(dir))
+    Some(crate::output::flight_sample(sim, rigid, name)?.velocity.dot(dir))
 }
 
 /// Run the case at `speed` (with `--resume`, continue it from the
@@ -2148,7 +2145,6 @@ mod tests {
                     let limit = study.limit.clone().unwrap();
                     let (held, perforated) = (limit.held.unwrap(), limit.perforated.unwrap());
                     assert!(held < v_bl && perforated >= v_bl && perforated - held <= 2.0, "{v_bl} {p}: {limit:?}");
-                    eprintln!("{v_bl} {p}: {rounds} rounds");
                     assert!(rounds <= 5, "{v_bl} {p}: {rounds} rounds");
                 }
             }

@@ -408,13 +408,7 @@ impl OutputWriter {
     /// ([`crate::contact::ContactSystem::deformable_sample`]).
     fn flight_sample(&self, sim: &Simulation, b: usize) -> Option<crate::contact::BodySample> {
         let rigid = sim.contact.as_ref().map_or(0, |c| c.bodies.len());
-        if b < rigid {
-            return sim.contact.as_ref()?.sample(b);
-        }
-        let name = self.names.get(b)?;
-        let body = sim.model.bodies.iter().position(|i| &i.name == name)? as u32;
-        let p = &sim.model.particles;
-        Some(crate::contact::deformable_sample(p, &sim.f_contact, body, sim.contact.as_ref()))
+        flight_sample(sim, (b < rigid).then_some(b), self.names.get(b).map_or("", String::as_str))
     }
 
     /// Where each flight is through its target ([`through_positions`]).
@@ -979,6 +973,20 @@ pub struct ExposedSummary {
     /// First and last history row with admitted particles in contact (s),
     /// and the most in contact in one row.
     pub contacts: Option<(Real, Real, usize)>,
+}
+
+/// A moving body's sample now, as the history records it: rigid body
+/// `rigid` of the contact, else the deformable body named `name`, its
+/// mass-averaged motion and the contact force on it
+/// ([`crate::contact::deformable_sample`]); `None` where
+/// there is no such body.
+pub fn flight_sample(sim: &Simulation, rigid: Option<usize>, name: &str) -> Option<crate::contact::BodySample> {
+    if let Some(k) = rigid {
+        return sim.contact.as_ref()?.sample(k);
+    }
+    let body = sim.model.bodies.iter().position(|i| i.name == name)? as u32;
+    let p = &sim.model.particles;
+    Some(crate::contact::deformable_sample(p, &sim.f_contact, body, sim.contact.as_ref()))
 }
 
 #[cfg(test)]

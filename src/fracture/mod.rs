@@ -713,7 +713,7 @@ impl FractureParameters {
     /// The defaults under `criterion`. The crack tip's rule is part of the
     /// model: the default model (`"nonlocal_damage"`) steps along the
     /// velocity jump with its compression gate read over `ℓ` (module doc,
-    /// "The default model's tip"), \[RL10\]'s criteria (the paper's mode)
+    /// "The default model's tip and damage"), \[RL10\]'s criteria (the paper's mode)
     /// step to the most damaged candidate with the particle's own gate, as
     /// SPEC §9 does. Everything else is the same for every criterion.
     pub fn for_criterion(criterion: Criterion) -> Self {
