@@ -516,33 +516,44 @@ impl Model {
             .map_or(Real::NAN, |h| h.max(-100.0))
     }
 
-    /// Lumped projection of a quadrature field onto the particles:
-    /// `f_I = Σ_q N_I(X_q) w_q f_q / Σ_q N_I(X_q) w_q` (the same weights as
-    /// the lumped mass).
-    ///
-    /// In parallel over the particles; each sums its own entries in fixed
-    /// order, so the result does not depend on the thread count.
+    /// Lumped projection of the quadrature field `f` at particle `i`:
+    /// `f_i = Σ_q N_i(X_q) w_q f_q / Σ_q N_i(X_q) w_q` (the same weights as
+    /// the lumped mass), summed in the gather table's fixed order;
+    /// `T::default()` (zero) where the particle has no points.
+    pub fn project_at<T>(&self, i: usize, f: impl Fn(usize) -> T) -> T
+    where
+        T: Copy
+            + std::ops::Add<Output = T>
+            + std::ops::Mul<Real, Output = T>
+            + std::ops::Div<Real, Output = T>
+            + Default,
+    {
+        let (mut acc, mut wsum) = (T::default(), 0.0);
+        for j in self.gather.range(i) {
+            let q = self.gather.point[j] as usize;
+            let w = self.gather.value[j] * self.quad.weight[q];
+            acc = acc + f(q) * w;
+            wsum += w;
+        }
+        if wsum != 0.0 {
+            acc / wsum
+        } else {
+            T::default()
+        }
+    }
+
+    /// [`Self::project_at`] at every particle, in parallel over them; the
+    /// result does not depend on the thread count.
     pub fn project<T>(&self, f: impl Fn(usize) -> T + Sync) -> Vec<T>
     where
-        T: Copy + Send + std::ops::Add<Output = T> + std::ops::Mul<Real, Output = T> + Default,
+        T: Copy
+            + Send
+            + std::ops::Add<Output = T>
+            + std::ops::Mul<Real, Output = T>
+            + std::ops::Div<Real, Output = T>
+            + Default,
     {
-        (0..self.particles.len())
-            .into_par_iter()
-            .map(|i| {
-                let (mut acc, mut wsum) = (T::default(), 0.0);
-                for j in self.gather.range(i) {
-                    let q = self.gather.point[j] as usize;
-                    let w = self.gather.value[j] * self.quad.weight[q];
-                    acc = acc + f(q) * w;
-                    wsum += w;
-                }
-                if wsum != 0.0 {
-                    acc * (1.0 / wsum)
-                } else {
-                    acc
-                }
-            })
-            .collect()
+        (0..self.particles.len()).into_par_iter().map(|i| self.project_at(i, &f)).collect()
     }
 
     /// Smallest particle spacing, m.

@@ -625,6 +625,14 @@ impl<const N: usize> std::ops::Mul<Real> for Row<N> {
     }
 }
 
+impl<const N: usize> std::ops::Div<Real> for Row<N> {
+    type Output = Row<N>;
+    #[inline]
+    fn div(self, s: Real) -> Row<N> {
+        Row(self.0.map(|x| x / s))
+    }
+}
+
 /// The particle cloud with the requested fields.
 ///
 /// The quadrature fields a snapshot asks for are projected in one pass

@@ -75,38 +75,12 @@ fn logged_event(
         (Real::NAN, Real::NAN)
     } else {
         (
-            lumped_projection(model, decider, |q| model.quad.damage[q]),
-            lumped_projection(model, decider, |q| model.adiabatic_hardening(q)),
+            model.project_at(decider, |q| model.quad.damage[q]),
+            model.project_at(decider, |q| model.adiabatic_hardening(q)),
         )
     };
     let particles = if kind.grows() { vec![decider] } else { Vec::new() };
     CrackEvent { time: at.0, step: at.1, crack, kind, particles, value, damage, hardening }
-}
-
-/// The lumped projection of the quadrature values `value(q)` at particle
-/// `i`, `Σ_q N_i(X_q) w_q c_q / Σ_q N_i(X_q) w_q` (0 without points).
-fn lumped_projection(model: &Model, i: usize, value: impl Fn(usize) -> Real) -> Real {
-    lumped(model, i, 0.0, value)
-}
-
-/// [`lumped_projection`] of a quantity of any kind `T` (a scalar, a
-/// tensor block), `zero` without points.
-fn lumped<T>(model: &Model, i: usize, zero: T, value: impl Fn(usize) -> T) -> T
-where
-    T: Copy + std::ops::Add<Output = T> + std::ops::Mul<Real, Output = T> + std::ops::Div<Real, Output = T>,
-{
-    let (mut acc, mut wsum) = (zero, 0.0);
-    for j in model.gather.range(i) {
-        let q = model.gather.point[j] as usize;
-        let w = model.gather.value[j] * model.quad.weight[q];
-        acc = acc + value(q) * w;
-        wsum += w;
-    }
-    if wsum != 0.0 {
-        acc / wsum
-    } else {
-        zero
-    }
 }
 
 /// The in-plane block of a [`crate::math::Block2`] as a matrix.
@@ -463,7 +437,7 @@ impl CrackGrowth {
             Criterion::NonlocalDamage => return self.nonlocal_damage(model, i),
             Criterion::None => return 0.0,
         };
-        lumped_projection(model, i, |q| col[q])
+        model.project_at(i, |q| col[q])
     }
 
     /// Johnson–Cook damage of particle `i` averaged over the material
@@ -547,7 +521,7 @@ impl CrackGrowth {
         if self.params.criterion != Criterion::NonlocalDamage {
             return value;
         }
-        lumped_projection(model, i, |q| model.quad.damage[q])
+        model.project_at(i, |q| model.quad.damage[q])
     }
 
     /// The direction a tip at particle `i` heads for in the reference
@@ -568,8 +542,8 @@ impl CrackGrowth {
         match self.params.tip_direction {
             TipDirection::MostDamaged => None,
             TipDirection::MaxShear => {
-                let tau = lumped(model, i, Matrix2::zeros(), |k| in_plane_matrix(&q.tau[k]));
-                let f = lumped(model, i, Matrix2::zeros(), |k| in_plane_matrix(&q.f[k]));
+                let tau = model.project_at(i, |k| in_plane_matrix(&q.tau[k]));
+                let f = model.project_at(i, |k| in_plane_matrix(&q.f[k]));
                 max_shear_direction(&tau, &f, reference)
             }
             TipDirection::VelocityJump => {

@@ -562,23 +562,28 @@ fn finite_min_max(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
     })
 }
 
-/// An axis range around `min_max` with 5 % padding. A degenerate range
-/// (one value, or a spread below 1e-12 of its magnitude, which plotters'
-/// tick generator cannot resolve) is widened to ±5 % of the value, ±1 at
-/// zero; no data gives 0..1.
-fn padded_range(min_max: Option<(f64, f64)>) -> (f64, f64) {
-    let Some((lo, hi)) = min_max else {
-        return (0.0, 1.0);
-    };
-    let magnitude = lo.abs().max(hi.abs());
-    let span = hi - lo;
-    let pad = if span > 1e-12 * magnitude {
+/// The padding on each side of data spanning `span` with values up to
+/// `magnitude`: 5 % of the span, or of the magnitude where the span is
+/// below 1e-12 of it (plotters' tick generator cannot resolve that), or 1
+/// where everything is zero.
+fn padding(span: f64, magnitude: f64) -> f64 {
+    if span > 1e-12 * magnitude {
         0.05 * span
     } else if magnitude > 0.0 {
         0.05 * magnitude
     } else {
         1.0
+    }
+}
+
+/// An axis range around `min_max` with [`padding`] on each side: a
+/// degenerate range (one value) is widened to ±5 % of the value, ±1 at
+/// zero; no data gives 0..1.
+fn padded_range(min_max: Option<(f64, f64)>) -> (f64, f64) {
+    let Some((lo, hi)) = min_max else {
+        return (0.0, 1.0);
     };
+    let pad = padding(hi - lo, lo.abs().max(hi.abs()));
     let (a, b) = (lo - pad, hi + pad);
     if a.is_finite() && b.is_finite() {
         (a, b)
@@ -595,13 +600,7 @@ fn equal_scale_ranges(xs: Option<(f64, f64)>, ys: Option<(f64, f64)>, pixels: (f
     };
     let span = (xs.1 - xs.0).max(ys.1 - ys.0);
     let magnitude = [xs.0, xs.1, ys.0, ys.1].iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let pad = if span > 1e-12 * magnitude {
-        0.05 * span
-    } else if magnitude > 0.0 {
-        0.05 * magnitude
-    } else {
-        1.0
-    };
+    let pad = padding(span, magnitude);
     let (x0, x1) = (xs.0 - pad, xs.1 + pad);
     let (y0, y1) = (ys.0 - pad, ys.1 + pad);
     let scale = ((x1 - x0) / pixels.0).max((y1 - y0) / pixels.1);
