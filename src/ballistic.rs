@@ -1702,7 +1702,8 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
         let st = &r.study;
         let reading = st.limit_reading();
         let limit = reading.as_ref().and_then(Limit::estimate);
-        let wall: Real = st.shots.iter().map(|s| s.wall).sum();
+        // folded from +0: `sum` of no runs is −0.0, which printed "-0"
+        let wall: Real = st.shots.iter().map(|s| s.wall).fold(0.0, |t, w| t + w);
         md.push_str(&format!(
             "| {} | {:.3} | {} | {} |",
             r.rows,
@@ -1758,7 +1759,7 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
             md.push_str(&x.map_or(" — |".into(), |(v, h)| format!(" {v:.2} ± {h:.2} |")));
         }
         let runs: usize = l.members.iter().map(|r| r.study.shots.len()).sum();
-        let wall: Real = l.members.iter().flat_map(|r| &r.study.shots).map(|s| s.wall).sum();
+        let wall: Real = l.members.iter().flat_map(|r| &r.study.shots).map(|s| s.wall).fold(0.0, |t, w| t + w);
         md.push_str(&format!(" {runs} | {wall:.0} | all |\n"));
     }
     let pct = |s: Option<Real>| s.map_or("—".into(), |x| format!("{:.1} %", 100.0 * x));
@@ -2457,6 +2458,13 @@ mod tests {
         // one phase per resolution reads as before: no envelope line
         let (md, _) = ladder_table(&rungs[..1], &[200.0]);
         assert!(!md.contains("phases |"), "{md}");
+        // a rung interrupted before its first run ended: 0 runs in 0 s (an
+        // empty float sum is −0.0, which printed "-0")
+        let mut empty = rungs[0].clone();
+        empty.study = Study::default();
+        let (md, csv) = ladder_table(&[empty], &[200.0]);
+        assert!(md.lines().nth(2).unwrap().contains("| 0 | 0 |") && !md.contains("-0"), "{md}");
+        assert!(csv.lines().nth(1).unwrap().contains(",0,0.00,"), "{csv}");
     }
 
     #[test]
