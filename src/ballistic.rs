@@ -1081,6 +1081,18 @@ pub fn find_limit(
     search_limit(bounds, tol, setup.jobs, study, &mut round)
 }
 
+/// Whether a limit search between `lo` and `hi` to `± tol` m/s can run:
+/// `0 < lo < hi` and `tol > 0` (checked before any run starts).
+pub fn check_search((lo, hi): (Real, Real), tol: Real) -> Result<(), BallisticError> {
+    if lo > 0.0 && hi > lo && tol > 0.0 {
+        Ok(())
+    } else {
+        Err(BallisticError::Settings(format!(
+            "the limit search needs 0 < --lo < --hi and --tol > 0 (lo = {lo}, hi = {hi}, tol = {tol} m/s)"
+        )))
+    }
+}
+
 /// How a limit search runs a round: `round(label, speeds, study)` runs
 /// the speeds and adds them to `study` ([`search_limit`]).
 pub type RunRound<'a> = dyn FnMut(String, Vec<Real>, &mut Study) -> Result<(), BallisticError> + 'a;
@@ -1096,11 +1108,7 @@ pub fn search_limit(
     study: &mut Study,
     round: &mut RunRound<'_>,
 ) -> Result<(), BallisticError> {
-    if !(lo > 0.0 && hi > lo && tol > 0.0) {
-        return Err(BallisticError::Settings(format!(
-            "the search needs 0 < lo < hi and tol > 0 (lo = {lo}, hi = {hi}, tol = {tol})"
-        )));
-    }
+    check_search((lo, hi), tol)?;
     round("bracket".into(), vec![lo, hi], study)?;
     let (mut lo, mut hi) = (lo, hi);
     for _ in 0..WIDEN_TRIES {

@@ -600,6 +600,12 @@ struct BallisticArgs {
 
 impl BallisticArgs {
     /// `--speeds`, the ranges spelt out, in the order given.
+    /// The limit search's bounds for a case fired at `impact` m/s:
+    /// `--lo` (default half of it) and `--hi` (default all of it).
+    fn bounds(&self, impact: f64) -> (f64, f64) {
+        (self.lo.unwrap_or(0.5 * impact), self.hi.unwrap_or(impact))
+    }
+
     fn speeds(&self) -> Vec<f64> {
         self.speeds.iter().flat_map(|s| s.0.iter().copied()).collect()
     }
@@ -684,6 +690,10 @@ fn ballistic(
                 case.time.end
             );
         }
+    }
+    if args.limit {
+        let (_, impact) = plugsim::ballistic::flight(&case, projectile);
+        plugsim::ballistic::check_search(args.bounds(impact), args.tol)?;
     }
     if !(args.snapshot_every.is_finite() && args.snapshot_every >= 0.0) {
         bail!("--snapshot-every must be a time >= 0 s (got {})", args.snapshot_every);
@@ -897,8 +907,7 @@ fn one_study(
     let mut study = Study::default();
     run_speeds(&setup, &args.speeds(), &mut study, &mut report, &mut progress)?;
     if args.limit && !study.interrupted {
-        let bounds = (args.lo.unwrap_or(0.5 * impact), args.hi.unwrap_or(impact));
-        find_limit(&setup, bounds, args.tol, &mut study, &mut report, &mut progress)?;
+        find_limit(&setup, args.bounds(impact), args.tol, &mut study, &mut report, &mut progress)?;
     }
     let files = write_files(out_dir, &header, &title, &study, &tests.points)?;
     println!("{}", plugsim::ballistic::report(&header, &study));

@@ -119,6 +119,23 @@ fn unwritable_output_path_is_named_and_nothing_is_left() {
 }
 
 #[test]
+fn a_limit_search_that_cannot_run_is_refused_before_any_run() {
+    // `--speeds` runs before the search: the bounds must be checked first,
+    // or a bad `--tol` is found only after the listed runs have been spent.
+    for (extra, named) in [
+        (&["--speeds", "300", "--limit", "--tol", "0"][..], "tol = 0 m/s"),
+        (&["--limit", "--lo", "300", "--hi", "100"][..], "lo = 300, hi = 100"),
+    ] {
+        let out_dir = scratch("bad-search").join("out");
+        let out = out_dir.display().to_string();
+        let args = [&["ballistic", "--case", "borvik-1-axisymmetric-nonlocal", "--out", &out][..], extra].concat();
+        let line = one_error_line(&plugsim(&args));
+        assert!(line.contains("the limit search needs") && line.contains(named), "{line}");
+        assert!(!out_dir.exists(), "nothing ran: {line}");
+    }
+}
+
+#[test]
 fn unknown_material_and_body_are_named() {
     let path = write_case("unknown-material", &STRIKE.replace("material = \"steel\"", "material = \"unobtainium\""));
     let line = refused(&path, &[], "unknown-material");
