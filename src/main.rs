@@ -871,7 +871,11 @@ fn one_study(
             }
             Event::Started { speed } => eprintln!("[{at:6.0} s]   {speed:.2} m/s started"),
             Event::Advanced { speed, time, end, along } => {
-                let along = along.map(|v| format!(", projectile at {v:.1} m/s")).unwrap_or_default();
+                // what decides a held run (`residual`): the end time is only a bound
+                let held = plugsim::residual::SLOW_FRACTION * speed;
+                let along = along
+                    .map(|v| format!(", projectile at {v:.1} m/s (held once under {held:.1} with no plug)"))
+                    .unwrap_or_default();
                 eprintln!("[{at:6.0} s]   {speed:.2} m/s at {:.1} of {:.1} us{along}", time * 1e6, end * 1e6)
             }
             Event::Finished { shot } => eprintln!(
