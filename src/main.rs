@@ -599,13 +599,13 @@ struct BallisticArgs {
 }
 
 impl BallisticArgs {
-    /// `--speeds`, the ranges spelt out, in the order given.
     /// The limit search's bounds for a case fired at `impact` m/s:
     /// `--lo` (default half of it) and `--hi` (default all of it).
     fn bounds(&self, impact: f64) -> (f64, f64) {
         (self.lo.unwrap_or(0.5 * impact), self.hi.unwrap_or(impact))
     }
 
+    /// `--speeds`, the ranges spelt out, in the order given.
     fn speeds(&self) -> Vec<f64> {
         self.speeds.iter().flat_map(|s| s.0.iter().copied()).collect()
     }
