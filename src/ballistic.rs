@@ -632,14 +632,14 @@ pub enum Event {
     /// and at the first step report (1/200 of the run's estimated steps)
     /// after each [`PROGRESS_WALL_INTERVAL`] of wall time; `along`
     /// is the projectile's speed along its flight then (m/s; the history's
-    /// sample, [`flight_speed`]).
+    /// sample, [`along_flight`]).
     Advanced { speed: Real, time: Real, end: Real, along: Option<Real> },
     /// A run finished; the table on disk includes it.
     Finished { shot: Shot },
     /// A run failed (the study goes on without it).
     Failed { speed: Real, message: String },
     /// A run stopped by the interrupt (its checkpoint is in its directory).
-    Interrupted { speed: Real },
+    Interrupted { paused: Paused },
     /// `--resume`: a run finished before with the same case, taken back
     /// as it is (the table on disk includes it); `note` when another build
     /// wrote it.
@@ -647,6 +647,21 @@ pub enum Event {
     /// `--resume`: an interrupted run continues from its checkpoint at
     /// `time` (s), with the checkpoint's warnings.
     Resumed { speed: Real, time: Real, warnings: Vec<String> },
+}
+
+/// A run the interrupt stopped, as the checkpoint it wrote then left it
+/// (`--resume` continues it from there).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Paused {
+    /// Impact speed, m/s.
+    pub speed: Real,
+    /// Simulated time of the checkpoint, s.
+    pub time: Real,
+    /// The projectile's motion along its flight then ([`along_flight`]);
+    /// `None` where the body was not found.
+    pub along: Option<AlongFlight>,
+    /// The run's directory (its history, snapshots and checkpoint).
+    pub dir: PathBuf,
 }
 
 /// What a study found.
@@ -658,6 +673,8 @@ pub struct Study {
     pub failures: Vec<(Real, String)>,
     /// Whether the interrupt stopped the study.
     pub interrupted: bool,
+    /// The runs the interrupt stopped, by speed.
+    pub paused: Vec<Paused>,
     /// The bisection's result, if it was asked for.
     pub limit: Option<Limit>,
     /// Recht–Ipson fit of the perforating points.
@@ -844,7 +861,11 @@ pub fn run_speeds(
                 }
             }
             Event::Failed { speed, message } => study.failures.push((*speed, message.clone())),
-            Event::Interrupted { .. } => study.interrupted = true,
+            Event::Interrupted { paused } => {
+                study.interrupted = true;
+                study.paused.push(paused.clone());
+                study.paused.sort_by(|a, b| a.speed.total_cmp(&b.speed));
+            }
             _ => {}
         }
         progress(event);
@@ -954,16 +975,33 @@ pub fn finished_run(setup: &Setup, speed: Real) -> Option<(Shot, Option<String>)
 /// takes tens of minutes per 10 % of its end time.
 pub const PROGRESS_WALL_INTERVAL: std::time::Duration = std::time::Duration::from_secs(120);
 
-/// The speed of `projectile` (named `name`) along its flight direction
-/// `dir` in `sim`, m/s: a rigid body's, or a deformable one's
-/// mass-averaged velocity, the history's sample
+/// A projectile's motion along its flight direction, as the history
+/// samples it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AlongFlight {
+    /// Its speed along the flight, m/s.
+    pub speed: Real,
+    /// The contact force on it along the flight, N: negative while the
+    /// target holds it back (`NAME_f_axial` in `history.csv`).
+    pub force: Real,
+}
+
+/// The motion of `projectile` (named `name`) along its flight direction
+/// `dir` in `sim`: a rigid body's, or a deformable one's mass-averaged
+/// velocity and the contact force on it, the history's sample
 /// ([`crate::output::flight_sample`]); `None` where the body is not found.
-pub fn flight_speed(sim: &crate::step::Simulation, projectile: Projectile, name: &str, dir: &Vec2) -> Option<Real> {
+pub fn along_flight(
+    sim: &crate::step::Simulation,
+    projectile: Projectile,
+    name: &str,
+    dir: &Vec2,
+) -> Option<AlongFlight> {
     let rigid = match projectile {
         Projectile::Rigid(k) => Some(k),
         Projectile::Deformable(_) => None,
     };
-    Some(crate::output::flight_sample(sim, rigid, name)?.velocity.dot(dir))
+    let s = crate::output::flight_sample(sim, rigid, name)?;
+    Some(AlongFlight { speed: s.velocity.dot(dir), force: s.contact_force.dot(dir) })
 }
 
 /// Run the case at `speed` (with `--resume`, continue it from the
@@ -983,6 +1021,8 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
     let name = setup.projectile.name(&case).to_string();
     let mut next = 0.1;
     let mut reported = std::time::Instant::now();
+    // the state at the last checkpoint: where an interrupt leaves the run
+    let mut saved: Option<(Real, Option<AlongFlight>)> = None;
     let mut report = |p: Progress| match p {
         Progress::Step { sim } => {
             let end = case.time.end;
@@ -992,9 +1032,12 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
                     next = (sim.time / end * 10.0).floor() / 10.0 + 0.1;
                 }
                 reported = std::time::Instant::now();
-                let along = flight_speed(sim, setup.projectile, &name, &direction);
+                let along = along_flight(sim, setup.projectile, &name, &direction).map(|a| a.speed);
                 let _ = tx.send(Event::Advanced { speed, time: sim.time, end, along });
             }
+        }
+        Progress::Checkpoint { sim, .. } => {
+            saved = Some((sim.time, along_flight(sim, setup.projectile, &name, &direction)));
         }
         Progress::Resumed { sim, warnings, .. } => {
             next = (sim.time / case.time.end * 10.0).floor() / 10.0 + 0.1;
@@ -1039,7 +1082,10 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
             }
             Event::Finished { shot }
         }
-        Err(RunError::Interrupted { .. }) => Event::Interrupted { speed },
+        Err(RunError::Interrupted { time, dir, .. }) => {
+            let along = saved.filter(|(t, _)| *t == time).and_then(|(_, a)| a);
+            Event::Interrupted { paused: Paused { speed, time, along, dir } }
+        }
         Err(e) => Event::Failed { speed, message: e.to_string() },
     }
 }
@@ -1376,6 +1422,28 @@ Recht-Ipson fit's v_bl. A search assumes the outcome changes once with the speed
 (`--speeds LO:HI:STEP`) shows whether it does. Recht-Ipson: v_r = a (v_i^p - v_bl^p)^(1/p), least squares \
 over the perforating runs with v_bl within the limit's bracket (p = 2 with fewer than three points).";
 
+/// The runs the interrupt stopped, where their checkpoints left them, as a
+/// Markdown table ("" without any): how far each got and whether the
+/// projectile was still held back, for deciding which to resume.
+pub fn paused_table(paused: &[Paused]) -> String {
+    if paused.is_empty() {
+        return String::new();
+    }
+    let mut s = String::from(
+        "Stopped with their checkpoints (`--resume` with the same command continues each from there):\n\n\
+         | v_i (m/s) | reached (us) | projectile along its flight (m/s) | force holding it back (kN) | directory |\n\
+         |---|---|---|---|---|\n",
+    );
+    for p in paused {
+        let (v, f) = p.along.map_or(("—".into(), "—".into()), |a| {
+            (format!("{:.2}", a.speed), format!("{:.1}", -a.force * 1e-3 + 0.0))
+        });
+        s.push_str(&format!("| {:.2} | {:.1} | {v} | {f} | {} |\n", p.speed, p.time * 1e6, p.dir.display()));
+    }
+    s.push('\n');
+    s
+}
+
 /// The Markdown report: `header` (case, settings, provenance), the table,
 /// the limit, the fit, the definitions and the plot.
 pub fn report(header: &str, study: &Study) -> String {
@@ -1383,6 +1451,7 @@ pub fn report(header: &str, study: &Study) -> String {
     let mut s = format!("# Ballistic study\n\n{header}\n\n{md}\n");
     if study.interrupted {
         s.push_str("**Interrupted**: the table holds the runs finished before the interrupt.\n\n");
+        s.push_str(&paused_table(&study.paused));
     }
     if let Some(l) = &study.limit_reading() {
         match (l.estimate(), l.held, l.perforated) {
@@ -2193,6 +2262,7 @@ mod tests {
             shots,
             failures: vec![],
             interrupted: false,
+            paused: vec![],
             limit: Some(Limit { held: h, perforated: p, tol: 1.0, non_monotonic: above }),
             fit: None,
         };
@@ -2225,6 +2295,26 @@ mod tests {
         assert_eq!(Study { shots: vec![], limit: None, ..study.clone() }.limit_reading(), None);
     }
 
+    /// An interrupted study's report lists each stopped run where its
+    /// checkpoint left it, the force as the plate's push against the
+    /// projectile; a finished study's lists none.
+    #[test]
+    fn an_interrupted_report_says_where_each_stopped_run_stands() {
+        let paused = |speed, along| Paused { speed, time: 328.5e-6, along, dir: PathBuf::from("runs/v278.90") };
+        let study = Study {
+            interrupted: true,
+            paused: vec![paused(278.9, Some(AlongFlight { speed: 6.716, force: -28_482.2 })), paused(292.1, None)],
+            ..Study::default()
+        };
+        let text = report("header", &study);
+        assert!(text.contains("**Interrupted**"), "{text}");
+        assert!(text.contains("| 278.90 | 328.5 | 6.72 | 28.5 | runs/v278.90 |"), "{text}");
+        assert!(text.contains("| 292.10 | 328.5 | — | — | runs/v278.90 |"), "{text}");
+        assert_eq!(text.matches("--resume").count(), 1, "{text}");
+        let finished = Study { interrupted: false, paused: vec![], ..study };
+        assert!(!report("header", &finished).contains("checkpoints"));
+    }
+
     /// The step's floors, the detached particles and the axis's work are
     /// named in the report, each with its largest run, and only where they
     /// acted.
@@ -2236,6 +2326,7 @@ mod tests {
             shots: shots.to_vec(),
             failures: vec![],
             interrupted: false,
+            paused: vec![],
             limit: None,
             fit: None,
         };

@@ -800,7 +800,12 @@ fn ballistic(
 /// Stop with an error if the study was interrupted.
 fn finish(study: &plugsim::ballistic::Study) -> Result<()> {
     if study.interrupted {
-        bail!("interrupted: the table keeps the {} runs finished before it", study.shots.len());
+        bail!(
+            "interrupted: the table keeps the {} runs finished before it; {} stopped with their checkpoints \
+             (--resume continues them)",
+            study.shots.len(),
+            study.paused.len()
+        );
     }
     Ok(())
 }
@@ -886,8 +891,16 @@ fn one_study(
                 shot.wall
             ),
             Event::Failed { speed, message } => eprintln!("[{at:6.0} s]   {speed:.2} m/s failed: {message}"),
-            Event::Interrupted { speed } => {
-                eprintln!("[{at:6.0} s]   {speed:.2} m/s interrupted (its checkpoint is kept: --resume continues it)")
+            Event::Interrupted { paused } => {
+                let along = paused
+                    .along
+                    .map(|a| format!(", projectile at {:.1} m/s held back by {:.1} kN", a.speed, -a.force * 1e-3 + 0.0))
+                    .unwrap_or_default();
+                eprintln!(
+                    "[{at:6.0} s]   {:.2} m/s interrupted at {:.1} us{along} (its checkpoint is kept: --resume continues it)",
+                    paused.speed,
+                    paused.time * 1e6
+                )
             }
             Event::Reused { shot, note } => eprintln!(
                 "[{at:6.0} s]   {:.2} m/s: {}{}, finished before: taken back{}",

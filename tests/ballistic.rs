@@ -2,7 +2,7 @@
 //! velocity every run reports (`plugsim::residual`).
 
 use plugsim::ballistic::{
-    at_rows, at_speed, find_limit, flight, flight_speed, run_speeds, select_projectile, write_files, Event, Projectile,
+    along_flight, at_rows, at_speed, find_limit, flight, run_speeds, select_projectile, write_files, Event, Projectile,
     Setup, Study,
 };
 use plugsim::case::Case;
@@ -460,13 +460,19 @@ fn a_study_fires_a_deformable_projectile() {
     let mut sim = plugsim::run::build_simulation(&s.case).unwrap();
     let (direction, impact) = flight(&s.case, projectile);
     let name = projectile.name(&s.case).to_string();
-    let at_start = flight_speed(&sim, projectile, &name, &direction).unwrap();
-    assert!((at_start - impact).abs() < 1e-9 * impact, "{at_start} against {impact}");
+    let at_start = along_flight(&sim, projectile, &name, &direction).unwrap();
+    assert!((at_start.speed - impact).abs() < 1e-9 * impact, "{at_start:?} against {impact}");
+    assert_eq!(at_start.force, 0.0, "no contact yet");
+    let mut pushed = 0;
     while sim.time < 5e-6 {
         sim.step().unwrap();
+        let now = along_flight(&sim, projectile, &name, &direction).unwrap();
+        assert!(now.force <= 0.0, "the plate only holds it back: {now:?} at {} s", sim.time);
+        pushed += usize::from(now.force < 0.0);
     }
-    let later = flight_speed(&sim, projectile, &name, &direction).unwrap();
-    assert!(later > 0.5 * impact && later < impact, "{later} m/s at 5 us of {impact}");
+    assert!(pushed > 10, "held back over {pushed} steps");
+    let later = along_flight(&sim, projectile, &name, &direction).unwrap();
+    assert!(later.speed > 0.5 * impact && later.speed < impact, "{later:?} at 5 us of {impact}");
     let mut study = Study::default();
     run_speeds(&s, &[500.0], &mut study, &mut |_| Ok(()), &mut |_| {}).unwrap();
     assert_eq!(study.shots.len(), 1, "{:?}", study.failures);
@@ -500,6 +506,8 @@ fn a_resumed_study_continues_the_interrupted_runs_and_takes_back_the_finished() 
         let mut s = setup(name, 1);
         s.case.time.end = 40.0e-6;
         s.max_time = 40.0e-6;
+        // a history row at every step, so one at the interrupt's checkpoint
+        s.case.output.history_every = 1;
         s
     };
     // The reference: never stopped.
@@ -530,6 +538,21 @@ fn a_resumed_study_continues_the_interrupted_runs_and_takes_back_the_finished() 
     assert!(along > 0.5 * speed && along < speed, "{along} m/s at 4 us of a {speed} m/s impact");
     let dir = plugsim::ballistic::run_dir(&s.out_dir, speed);
     assert!(!dir.join(plugsim::ballistic::SHOT_FILE).exists());
+    // the stopped run, where its checkpoint left it: the history's last
+    // row, the projectile slower than at the report and held back
+    let [paused] = study.paused.as_slice() else { panic!("one stopped run: {:?}", study.paused) };
+    assert_eq!((paused.speed, &paused.dir), (speed, &dir));
+    let history = std::fs::read_to_string(dir.join("history.csv")).unwrap();
+    let (head, last) = (history.lines().next().unwrap(), history.lines().last().unwrap());
+    let column = |name: &str| -> f64 {
+        let k = head.split(',').position(|c| c == name).unwrap();
+        last.split(',').nth(k).unwrap().parse().unwrap()
+    };
+    assert_eq!(paused.time, column("time"), "the checkpoint's time is the history's last row");
+    let at = paused.along.expect("the projectile's motion at the checkpoint");
+    assert!(at.speed <= along && at.speed > 0.5 * speed, "{at:?}");
+    assert_eq!(at.force, column("projectile_f_axial"), "the history's sample");
+    assert_eq!(at.speed, -column("projectile_vy"), "the history's sample (the flight is along -y)");
 
     // Resumed: continues from the checkpoint, to the reference's result.
     s.interrupt = None;
@@ -542,6 +565,7 @@ fn a_resumed_study_continues_the_interrupted_runs_and_takes_back_the_finished() 
         _ => None,
     });
     assert!(resumed_at.is_some_and(|t| t >= 4.0e-6 && t < reference.end_time), "{resumed_at:?}");
+    assert_eq!(resumed_at, Some(paused.time), "continues where the report said it stopped");
     same(&study.shots[0], &reference);
     assert!(dir.join(plugsim::ballistic::SHOT_FILE).exists());
     let history = std::fs::read(dir.join("history.csv")).unwrap();
