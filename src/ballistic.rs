@@ -675,6 +675,8 @@ pub struct Study {
     pub interrupted: bool,
     /// The runs the interrupt stopped, by speed.
     pub paused: Vec<Paused>,
+    /// The speeds (m/s) the interrupt came before, in the order asked.
+    pub not_started: Vec<Real>,
     /// The bisection's result, if it was asked for.
     pub limit: Option<Limit>,
     /// Recht–Ipson fit of the perforating points.
@@ -892,6 +894,7 @@ pub fn run_speeds(
     });
     if stop.load(Ordering::SeqCst) {
         study.interrupted = true;
+        study.not_started.extend(queue.into_inner().unwrap_or_else(|e| e.into_inner()));
     }
     result
 }
@@ -1452,6 +1455,10 @@ pub fn report(header: &str, study: &Study) -> String {
     if study.interrupted {
         s.push_str("**Interrupted**: the table holds the runs finished before the interrupt.\n\n");
         s.push_str(&paused_table(&study.paused));
+        if !study.not_started.is_empty() {
+            let v: Vec<String> = study.not_started.iter().map(|v| format!("{v:.2}")).collect();
+            s.push_str(&format!("Not started before the interrupt (`--resume` runs them): {} m/s.\n\n", v.join(", ")));
+        }
     }
     if let Some(l) = &study.limit_reading() {
         match (l.estimate(), l.held, l.perforated) {
@@ -2263,6 +2270,7 @@ mod tests {
             failures: vec![],
             interrupted: false,
             paused: vec![],
+            not_started: vec![],
             limit: Some(Limit { held: h, perforated: p, tol: 1.0, non_monotonic: above }),
             fit: None,
         };
@@ -2304,15 +2312,18 @@ mod tests {
         let study = Study {
             interrupted: true,
             paused: vec![paused(278.9, Some(AlongFlight { speed: 6.716, force: -28_482.2 })), paused(292.1, None)],
+            not_started: vec![300.0, 285.5],
             ..Study::default()
         };
         let text = report("header", &study);
         assert!(text.contains("**Interrupted**"), "{text}");
         assert!(text.contains("| 278.90 | 328.5 | 6.72 | 28.5 | runs/v278.90 |"), "{text}");
         assert!(text.contains("| 292.10 | 328.5 | — | — | runs/v278.90 |"), "{text}");
-        assert_eq!(text.matches("--resume").count(), 1, "{text}");
-        let finished = Study { interrupted: false, paused: vec![], ..study };
-        assert!(!report("header", &finished).contains("checkpoints"));
+        assert!(text.contains("Not started before the interrupt (`--resume` runs them): 300.00, 285.50 m/s."));
+        assert_eq!(text.matches("--resume").count(), 2, "{text}");
+        let finished = Study { interrupted: false, paused: vec![], not_started: vec![], ..study };
+        let text = report("header", &finished);
+        assert!(!text.contains("checkpoints") && !text.contains("Not started"), "{text}");
     }
 
     /// The step's floors, the detached particles and the axis's work are
@@ -2327,6 +2338,7 @@ mod tests {
             failures: vec![],
             interrupted: false,
             paused: vec![],
+            not_started: vec![],
             limit: None,
             fit: None,
         };

@@ -802,9 +802,10 @@ fn finish(study: &plugsim::ballistic::Study) -> Result<()> {
     if study.interrupted {
         bail!(
             "interrupted: the table keeps the {} runs finished before it; {} stopped with their checkpoints \
-             (--resume continues them)",
+             and {} not started (--resume continues them)",
             study.shots.len(),
-            study.paused.len()
+            study.paused.len(),
+            study.not_started.len()
         );
     }
     Ok(())

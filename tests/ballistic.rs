@@ -241,6 +241,12 @@ fn an_interrupt_keeps_the_finished_runs() {
     assert!(study.interrupted);
     assert_eq!(study.shots.len(), 1);
     assert_eq!(study.shots[0].speed, 450.0);
+    // the rest: stopped in flight (the next one may have started before
+    // the flag was seen) or not started, none lost
+    let mut rest: Vec<f64> = study.paused.iter().map(|p| p.speed).chain(study.not_started.iter().copied()).collect();
+    rest.sort_by(f64::total_cmp);
+    assert_eq!(rest, vec![250.0, 350.0], "{:?} {:?}", study.paused, study.not_started);
+    assert!(study.not_started.contains(&250.0), "{:?}", study.not_started);
     let csv = std::fs::read_to_string(s.out_dir.join("ballistic.csv")).unwrap();
     assert!(csv.lines().nth(1).unwrap().starts_with("450.00,"), "{csv}");
     assert_eq!(csv.lines().count(), 2);
@@ -531,7 +537,7 @@ fn a_resumed_study_continues_the_interrupted_runs_and_takes_back_the_finished() 
         }
     })
     .unwrap();
-    assert!(study.interrupted && study.shots.is_empty());
+    assert!(study.interrupted && study.shots.is_empty() && study.not_started.is_empty());
     // the report carries the projectile's speed along its flight: slowed
     // by the plate at 4 us, still moving on
     let along = reported.flatten().expect("the projectile's speed in the progress report");
