@@ -16,7 +16,7 @@ use std::time::Instant;
 #[command(name = "plugsim", version = concat!(env!("CARGO_PKG_VERSION"), " (", env!("PLUGSIM_COMMIT"), ")"),
           about = "Meshfree (RKPM) simulation of high-speed impact, plugging and ductile fracture")]
 struct Cli {
-    /// Worker threads (default: all cores).
+    /// Worker threads (default, or 0: all cores).
     #[arg(long, global = true)]
     threads: Option<usize>,
     #[command(subcommand)]
@@ -524,6 +524,15 @@ fn speed_item(item: &str) -> Result<SpeedItem, String> {
     plugsim::ballistic::parse_speeds(item).map(SpeedItem)
 }
 
+/// `--jobs`: a whole number of runs side by side, at least one.
+fn jobs_count(text: &str) -> Result<usize, String> {
+    match text.parse::<usize>() {
+        Ok(0) => Err("at least 1 run side by side (got 0)".into()),
+        Ok(n) => Ok(n),
+        Err(_) => Err(format!("a whole number of runs side by side, at least 1 (got '{text}')")),
+    }
+}
+
 /// `plugsim ballistic`'s options besides the case, the overrides and the
 /// output directory.
 #[derive(clap::Args)]
@@ -552,8 +561,9 @@ struct BallisticArgs {
     /// The body to fire, rigid or deformable (default: the case's only moving one).
     #[arg(long)]
     projectile: Option<String>,
-    /// Runs side by side (default: one per core, one thread each).
-    #[arg(long)]
+    /// Runs side by side, at least 1 (default: one per core, one thread
+    /// each).
+    #[arg(long, value_parser = jobs_count)]
     jobs: Option<usize>,
     /// Experimental points to plot: a CSV with header v_i,v_r (m/s). Default: a built-in
     /// Borvik case's own tests (cases/reference/), unless --set changed its plate's thickness

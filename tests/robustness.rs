@@ -135,6 +135,21 @@ fn a_limit_search_that_cannot_run_is_refused_before_any_run() {
     }
 }
 
+/// `--jobs 0` (no run could start) is refused by the parser before any
+/// run, naming the option; it used to run as `--jobs 1`.
+#[test]
+fn no_runs_side_by_side_is_refused() {
+    let out_dir = scratch("no-jobs").join("out");
+    let out = out_dir.display().to_string();
+    let args =
+        ["ballistic", "--case", "borvik-1-axisymmetric-nonlocal", "--speeds", "300", "--jobs", "0", "--out", &out];
+    let run = plugsim(&args);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "a usage error: {stderr}");
+    assert!(stderr.contains("'0'") && stderr.contains("--jobs") && stderr.contains("at least 1"), "{stderr}");
+    assert!(!out_dir.exists(), "nothing ran: {stderr}");
+}
+
 #[test]
 fn unknown_material_and_body_are_named() {
     let path = write_case("unknown-material", &STRIKE.replace("material = \"steel\"", "material = \"unobtainium\""));
