@@ -48,7 +48,9 @@
 //! worker threads (the solver's results do not depend on the thread count).
 //! The table is rewritten after every finished run, so an interrupt keeps
 //! every run finished before it, and each run in flight writes a
-//! checkpoint. The library never prints: progress goes to a callback.
+//! checkpoint; the report lists those runs where their checkpoints left
+//! them ([`Paused`], [`paused_table`]) and the speeds not started. The
+//! library never prints: progress goes to a callback.
 //!
 //! - **Resume** ([`Setup::resume`], `--resume`): the same study run again
 //!   into the same directory takes back every run that finished there
