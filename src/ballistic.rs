@@ -991,6 +991,13 @@ pub struct AlongFlight {
     pub force: Real,
 }
 
+impl AlongFlight {
+    /// The force holding it back, N: `-force`, and 0 (not −0) when free.
+    pub fn holding_back(&self) -> Real {
+        -self.force + 0.0
+    }
+}
+
 /// The motion of `projectile` (named `name`) along its flight direction
 /// `dir` in `sim`: a rigid body's, or a deformable one's mass-averaged
 /// velocity and the contact force on it, the history's sample
@@ -1441,7 +1448,7 @@ pub fn paused_table(paused: &[Paused]) -> String {
     );
     for p in paused {
         let (v, f) = p.along.map_or(("—".into(), "—".into()), |a| {
-            (format!("{:.2}", a.speed), format!("{:.1}", -a.force * 1e-3 + 0.0))
+            (format!("{:.2}", a.speed), format!("{:.1}", a.holding_back() * 1e-3))
         });
         s.push_str(&format!("| {:.2} | {:.1} | {v} | {f} | {} |\n", p.speed, p.time * 1e6, p.dir.display()));
     }

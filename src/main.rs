@@ -905,7 +905,9 @@ fn one_study(
             Event::Interrupted { paused } => {
                 let along = paused
                     .along
-                    .map(|a| format!(", projectile at {:.1} m/s held back by {:.1} kN", a.speed, -a.force * 1e-3 + 0.0))
+                    .map(|a| {
+                        format!(", projectile at {:.1} m/s held back by {:.1} kN", a.speed, a.holding_back() * 1e-3)
+                    })
                     .unwrap_or_default();
                 eprintln!(
                     "[{at:6.0} s]   {:.2} m/s interrupted at {:.1} us{along} (its checkpoint is kept: --resume continues it)",

@@ -545,15 +545,11 @@ fn a_resumed_study_continues_the_interrupted_runs_and_takes_back_the_finished() 
     let dir = plugsim::ballistic::run_dir(&s.out_dir, speed);
     assert!(!dir.join(plugsim::ballistic::SHOT_FILE).exists());
     // the stopped run, where its checkpoint left it: the history's last
-    // row, the projectile slower than at the report and held back
+    // row, the projectile no faster than at the report
     let [paused] = study.paused.as_slice() else { panic!("one stopped run: {:?}", study.paused) };
     assert_eq!((paused.speed, &paused.dir), (speed, &dir));
-    let history = std::fs::read_to_string(dir.join("history.csv")).unwrap();
-    let (head, last) = (history.lines().next().unwrap(), history.lines().last().unwrap());
-    let column = |name: &str| -> f64 {
-        let k = head.split(',').position(|c| c == name).unwrap();
-        last.split(',').nth(k).unwrap().parse().unwrap()
-    };
+    let history = plugsim::output::read_history(&dir).unwrap();
+    let column = |name: &str| *history.column(name).and_then(|c| c.last()).unwrap();
     assert_eq!(paused.time, column("time"), "the checkpoint's time is the history's last row");
     let at = paused.along.expect("the projectile's motion at the checkpoint");
     assert!(at.speed <= along && at.speed > 0.5 * speed, "{at:?}");
