@@ -634,8 +634,10 @@ pub enum Event {
     /// and at the first step report (1/200 of the run's estimated steps)
     /// after each [`PROGRESS_WALL_INTERVAL`] of wall time; `along`
     /// is the projectile's speed along its flight then (m/s; the history's
-    /// sample, [`along_flight`]).
-    Advanced { speed: Real, time: Real, end: Real, along: Option<Real> },
+    /// sample, [`along_flight`]), `perforation` when the cracks first cut a
+    /// plug out (s; `None` before), which sets the speed under which the
+    /// run counts as held ([`crate::residual::held_below`]).
+    Advanced { speed: Real, time: Real, end: Real, along: Option<Real>, perforation: Option<Real> },
     /// A run finished; the table on disk includes it.
     Finished { shot: Shot },
     /// A run failed (the study goes on without it).
@@ -662,6 +664,8 @@ pub struct Paused {
     /// The projectile's motion along its flight then ([`along_flight`]);
     /// `None` where the body was not found.
     pub along: Option<AlongFlight>,
+    /// When the cracks first cut a plug out, s; `None` if none was by then.
+    pub perforation: Option<Real>,
     /// The run's directory (its history, snapshots and checkpoint).
     pub dir: PathBuf,
 }
@@ -1034,9 +1038,9 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
     let mut next = 0.1;
     let mut reported = std::time::Instant::now();
     // the state at the last checkpoint: where an interrupt leaves the run
-    let mut saved: Option<(Real, Option<AlongFlight>)> = None;
+    let mut saved: Option<(Real, Option<AlongFlight>, Option<Real>)> = None;
     let mut report = |p: Progress| match p {
-        Progress::Step { sim } => {
+        Progress::Step { sim, perforation } => {
             let end = case.time.end;
             let mark = sim.time >= next * end;
             if mark || reported.elapsed() >= PROGRESS_WALL_INTERVAL {
@@ -1045,11 +1049,11 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
                 }
                 reported = std::time::Instant::now();
                 let along = along_flight(sim, setup.projectile, &name, &direction).map(|a| a.speed);
-                let _ = tx.send(Event::Advanced { speed, time: sim.time, end, along });
+                let _ = tx.send(Event::Advanced { speed, time: sim.time, end, along, perforation });
             }
         }
-        Progress::Checkpoint { sim, .. } => {
-            saved = Some((sim.time, along_flight(sim, setup.projectile, &name, &direction)));
+        Progress::Checkpoint { sim, perforation, .. } => {
+            saved = Some((sim.time, along_flight(sim, setup.projectile, &name, &direction), perforation));
         }
         Progress::Resumed { sim, warnings, .. } => {
             next = (sim.time / case.time.end * 10.0).floor() / 10.0 + 0.1;
@@ -1095,8 +1099,8 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
             Event::Finished { shot }
         }
         Err(RunError::Interrupted { time, dir, .. }) => {
-            let along = saved.filter(|(t, _)| *t == time).and_then(|(_, a)| a);
-            Event::Interrupted { paused: Paused { speed, time, along, dir } }
+            let (along, perforation) = saved.filter(|(t, ..)| *t == time).map_or((None, None), |(_, a, p)| (a, p));
+            Event::Interrupted { paused: Paused { speed, time, along, perforation, dir } }
         }
         Err(e) => Event::Failed { speed, message: e.to_string() },
     }
@@ -1443,14 +1447,15 @@ pub fn paused_table(paused: &[Paused]) -> String {
     }
     let mut s = String::from(
         "Stopped with their checkpoints (`--resume` with the same command continues each from there):\n\n\
-         | v_i (m/s) | reached (us) | projectile along its flight (m/s) | force holding it back (kN) | directory |\n\
-         |---|---|---|---|---|\n",
+         | v_i (m/s) | reached (us) | projectile along its flight (m/s) | force holding it back (kN) | plug cut at (us) | directory |\n\
+         |---|---|---|---|---|---|\n",
     );
     for p in paused {
         let (v, f) = p.along.map_or(("—".into(), "—".into()), |a| {
             (format!("{:.2}", a.speed), format!("{:.1}", a.holding_back() * 1e-3))
         });
-        s.push_str(&format!("| {:.2} | {:.1} | {v} | {f} | {} |\n", p.speed, p.time * 1e6, p.dir.display()));
+        let cut = p.perforation.map_or("—".into(), |t| format!("{:.2}", t * 1e6));
+        s.push_str(&format!("| {:.2} | {:.1} | {v} | {f} | {cut} | {} |\n", p.speed, p.time * 1e6, p.dir.display()));
     }
     s.push('\n');
     s
@@ -2317,17 +2322,26 @@ mod tests {
     /// projectile; a finished study's lists none.
     #[test]
     fn an_interrupted_report_says_where_each_stopped_run_stands() {
-        let paused = |speed, along| Paused { speed, time: 328.5e-6, along, dir: PathBuf::from("runs/v278.90") };
+        let paused = |speed, along, perforation| Paused {
+            speed,
+            time: 328.5e-6,
+            along,
+            perforation,
+            dir: PathBuf::from("runs/v278.90"),
+        };
         let study = Study {
             interrupted: true,
-            paused: vec![paused(278.9, Some(AlongFlight { speed: 6.716, force: -28_482.2 })), paused(292.1, None)],
+            paused: vec![
+                paused(278.9, Some(AlongFlight { speed: 6.716, force: -28_482.2 }), Some(89.004e-6)),
+                paused(292.1, None, None),
+            ],
             not_started: vec![300.0, 285.5],
             ..Study::default()
         };
         let text = report("header", &study);
         assert!(text.contains("**Interrupted**"), "{text}");
-        assert!(text.contains("| 278.90 | 328.5 | 6.72 | 28.5 | runs/v278.90 |"), "{text}");
-        assert!(text.contains("| 292.10 | 328.5 | — | — | runs/v278.90 |"), "{text}");
+        assert!(text.contains("| 278.90 | 328.5 | 6.72 | 28.5 | 89.00 | runs/v278.90 |"), "{text}");
+        assert!(text.contains("| 292.10 | 328.5 | — | — | — | runs/v278.90 |"), "{text}");
         assert!(text.contains("Not started before the interrupt (`--resume` runs them): 300.00, 285.50 m/s."));
         assert_eq!(text.matches("--resume").count(), 2, "{text}");
         let finished = Study { interrupted: false, paused: vec![], not_started: vec![], ..study };

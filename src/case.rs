@@ -694,6 +694,9 @@ impl Case {
             validate_grid(&mut add, &format!("{k}.rectangle"), &body.rectangle, self.geometry.mode);
             for (j, iv) in body.initial_velocity.iter().enumerate() {
                 finite2(&mut add, &format!("{k}.initial_velocity[{j}].velocity"), iv.velocity, "m/s");
+                if let Some(message) = self.speed_problem(norm2(iv.velocity)) {
+                    add(format!("{k}.initial_velocity[{j}].velocity"), message);
+                }
                 if let Some(r) = &iv.region {
                     validate_region(&mut add, &format!("{k}.initial_velocity[{j}].region"), r);
                 }
@@ -749,6 +752,9 @@ impl Case {
                 }
             }
             finite2(&mut add, &format!("{k}.velocity"), rb.velocity, "m/s");
+            if let Some(message) = self.speed_problem(norm2(rb.velocity)) {
+                add(format!("{k}.velocity"), message);
+            }
         }
         let mu = self.contact.friction_coefficient;
         if !(mu.is_finite() && mu >= 0.0) {
@@ -866,6 +872,38 @@ impl Case {
     }
 
     /// The material named `name`: from this file, else a built-in.
+    /// The fastest impact the model describes, m/s, and the body that sets
+    /// it: the lowest elastic longitudinal wave speed `c_L` of the deformable
+    /// bodies' materials (`None` where no body's material is known and
+    /// sound). At or above `c_L` the impact outruns the elastic wave, a
+    /// shock (hypervelocity) regime that SPEC §6's hypoelastic pressure with
+    /// no shock equation of state does not describe; in practice such a
+    /// speed is one given in another unit (mm/s, km/h). Steel's `c_L` is
+    /// about 5.9 km/s, copper's 4.7: far above the few hundred m/s of
+    /// ballistic plugging and Taylor tests.
+    pub fn speed_ceiling(&self) -> Option<(Real, &str)> {
+        self.bodies
+            .iter()
+            .filter_map(|b| {
+                let c = self.material(&b.material)?.longitudinal_wave_speed();
+                (c.is_finite() && c > 0.0).then_some((c, b.name.as_str()))
+            })
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+    }
+
+    /// Why `speed` (m/s) is not an impact speed the model describes
+    /// ([`Case::speed_ceiling`]); `None` where it is.
+    pub fn speed_problem(&self, speed: Real) -> Option<String> {
+        let (c, body) = self.speed_ceiling()?;
+        (speed >= c).then(|| {
+            format!(
+                "{speed} m/s is at or above the elastic wave speed of body '{body}' ({c:.0} m/s): \
+                 a hypervelocity impact, which the model (no shock equation of state) does not describe; \
+                 is the speed in another unit?"
+            )
+        })
+    }
+
     pub fn material(&self, name: &str) -> Option<Material> {
         match self.materials.get(name) {
             Some(spec) => Some(spec.to_material()),
@@ -1132,6 +1170,11 @@ fn non_negative(add: &mut impl FnMut(String, String), key: &str, v: Real, unit: 
     if !(v.is_finite() && v >= 0.0) {
         add(key.to_string(), format!("must be zero or positive (in {unit}), got {v}"));
     }
+}
+
+/// The length of a vector given as `[x, y]`.
+fn norm2(v: [Real; 2]) -> Real {
+    v[0].hypot(v[1])
 }
 
 fn finite2(add: &mut impl FnMut(String, String), key: &str, v: [Real; 2], unit: &str) {

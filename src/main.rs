@@ -538,7 +538,8 @@ fn jobs_count(text: &str) -> Result<usize, String> {
 #[derive(clap::Args)]
 struct BallisticArgs {
     /// Impact speeds to run, m/s: comma-separated, each a speed or an inclusive range
-    /// LO:HI:STEP (e.g. --speeds 116:134:1,140,150).
+    /// LO:HI:STEP (e.g. --speeds 116:134:1,140,150); each under the elastic wave speed of
+    /// every body (a faster impact is a shock the model does not describe).
     #[arg(long, value_delimiter = ',', value_parser = speed_item)]
     speeds: Vec<SpeedItem>,
     /// Find the ballistic limit by bisection.
@@ -704,6 +705,14 @@ fn ballistic(
     if args.limit {
         let (_, impact) = plugsim::ballistic::flight(&case, projectile);
         plugsim::ballistic::check_search(args.bounds(impact), args.tol)?;
+    }
+    // The speeds as the case's own velocity is checked (`Case::speed_problem`);
+    // the search's bounds are the highest speeds it asks for.
+    let asked = speeds.iter().map(|&v| ("--speeds", v));
+    let bounds = args.limit.then(|| args.bounds(plugsim::ballistic::flight(&case, projectile).1));
+    let searched = bounds.into_iter().flat_map(|(lo, hi)| [("--lo", lo), ("--hi", hi)]);
+    if let Some((option, problem)) = asked.chain(searched).find_map(|(o, v)| Some((o, case.speed_problem(v)?))) {
+        bail!("{option}: {problem}");
     }
     if !(args.snapshot_every.is_finite() && args.snapshot_every >= 0.0) {
         bail!("--snapshot-every must be a time >= 0 s (got {})", args.snapshot_every);
@@ -886,11 +895,17 @@ fn one_study(
                 eprintln!("[{at:6.0} s] {label}: {} m/s", v.join(", "));
             }
             Event::Started { speed } => eprintln!("[{at:6.0} s]   {speed:.2} m/s started"),
-            Event::Advanced { speed, time, end, along } => {
+            Event::Advanced { speed, time, end, along, perforation } => {
                 // what decides a held run (`residual`): the end time is only a bound
-                let held = plugsim::residual::SLOW_FRACTION * speed;
+                let held = plugsim::residual::held_below(speed, perforation.is_some());
                 let along = along
-                    .map(|v| format!(", projectile at {v:.1} m/s (held once under {held:.1} with no plug)"))
+                    .map(|v| match perforation {
+                        None => format!(", projectile at {v:.1} m/s (held once under {held:.1} with no plug)"),
+                        Some(t) => format!(
+                            ", projectile at {v:.1} m/s, plug cut at {:.1} us (held once under {held:.1})",
+                            t * 1e6
+                        ),
+                    })
                     .unwrap_or_default();
                 eprintln!("[{at:6.0} s]   {speed:.2} m/s at {:.1} of {:.1} us{along}", time * 1e6, end * 1e6)
             }
@@ -909,8 +924,9 @@ fn one_study(
                         format!(", projectile at {:.1} m/s held back by {:.1} kN", a.speed, a.holding_back() * 1e-3)
                     })
                     .unwrap_or_default();
+                let cut = paused.perforation.map(|t| format!(", plug cut at {:.1} us", t * 1e6)).unwrap_or_default();
                 eprintln!(
-                    "[{at:6.0} s]   {:.2} m/s interrupted at {:.1} us{along} (its checkpoint is kept: --resume continues it)",
+                    "[{at:6.0} s]   {:.2} m/s interrupted at {:.1} us{along}{cut} (its checkpoint is kept: --resume continues it)",
                     paused.speed,
                     paused.time * 1e6
                 )
@@ -1133,7 +1149,7 @@ fn drive(
             }
             eprintln!("plugsim: resuming from {} at step {} (t = {:.4e} s)", checkpoint.display(), sim.step, sim.time);
         }
-        Progress::Checkpoint { sim, path } => {
+        Progress::Checkpoint { sim, path, .. } => {
             let line = format!("  checkpoint at step {} (t = {:.4e} s): {}", sim.step, sim.time, path.display());
             if tty {
                 bar.println(line);
@@ -1163,8 +1179,9 @@ fn drive(
                 );
             }
         }
-        Progress::Step { sim } => {
-            let msg = format!("t = {:.3} us / {:.3} us, step {}", sim.time * 1e6, end * 1e6, sim.step);
+        Progress::Step { sim, perforation } => {
+            let cut = perforation.map(|t| format!(", plug cut at {:.2} us", t * 1e6)).unwrap_or_default();
+            let msg = format!("t = {:.3} us / {:.3} us, step {}{cut}", sim.time * 1e6, end * 1e6, sim.step);
             if tty {
                 bar.set_position(sim.step);
                 bar.set_message(msg);

@@ -284,6 +284,12 @@ impl OutputWriter {
         Ok(path)
     }
 
+    /// When the cracks first cut a plug out (s; the `perforation_time`
+    /// column), `None` before.
+    pub fn perforation(&self) -> Option<Real> {
+        self.plug.first_cut
+    }
+
     /// Wait for the snapshot being written, if any, and add its files to
     /// `results.pvd`.
     pub fn flush(&mut self) -> Result<(), IoError> {

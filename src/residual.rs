@@ -85,6 +85,14 @@ pub const STOP_FRACTION: Real = 0.01;
 /// plate (module doc).
 pub const SLOW_FRACTION: Real = 0.05;
 
+/// The speed along the flight (m/s) at or below which a projectile fired at
+/// `impact_speed` counts as held ([`verdict`]): [`STOP_FRACTION`] of it once
+/// a plug is cut out (or the projectile is through its target, `plug`),
+/// [`SLOW_FRACTION`] before.
+pub fn held_below(impact_speed: Real, plug: bool) -> Real {
+    impact_speed * if plug { STOP_FRACTION } else { SLOW_FRACTION }
+}
+
 /// The position along the flight, `x·d` of the body frame's origin (m),
 /// from which a projectile has passed through its target (module doc):
 /// its nose, `nose` ahead of the origin along the flight (the largest
@@ -307,6 +315,21 @@ mod tests {
                 row
             })
             .collect()
+    }
+
+    #[test]
+    fn the_held_speed_is_the_one_the_verdict_applies() {
+        // Still pushed after the braking, at a steady speed on either side of
+        // `held_below`: held just under it, undecided just over, with and
+        // without a plug (1 % and 5 % of 300 m/s: 3 and 15 m/s).
+        for (plug, expected) in [(false, 15.0), (true, 3.0)] {
+            let held = held_below(300.0, plug);
+            assert!((held - expected).abs() < 1e-12, "plug {plug}: {held}");
+            let under = verdict(rows(|_| (-1.0e6, 0.999 * held)), 300.0, plug, None);
+            assert!(matches!(under, Verdict::Held { .. }), "plug {plug}, {:.3} m/s: {under:?}", 0.999 * held);
+            let over = verdict(rows(|_| (-1.0e6, 1.001 * held)), 300.0, plug, None);
+            assert!(matches!(over, Verdict::Undecided { .. }), "plug {plug}, {:.3} m/s: {over:?}", 1.001 * held);
+        }
     }
 
     #[test]

@@ -288,10 +288,12 @@ pub enum Progress<'a> {
     Resumed { sim: &'a Simulation, checkpoint: &'a Path, warnings: &'a [String] },
     /// The model is built; the loop is about to start (or continue).
     Started { sim: &'a Simulation, steps_estimate: u64, end: Real },
-    /// Periodic, during the loop.
-    Step { sim: &'a Simulation },
-    /// A checkpoint was written.
-    Checkpoint { sim: &'a Simulation, path: &'a Path },
+    /// Periodic, during the loop; `perforation` is when the cracks first
+    /// cut a plug out (s; the history's `perforation_time`, [`crate::plug`]),
+    /// `None` before.
+    Step { sim: &'a Simulation, perforation: Option<Real> },
+    /// A checkpoint was written; `perforation` as in `Step`.
+    Checkpoint { sim: &'a Simulation, path: &'a Path, perforation: Option<Real> },
     /// The loop reached `time.end`; `sim` is the final state.
     Finished { sim: &'a Simulation },
 }
@@ -484,7 +486,7 @@ fn time_loop(
             let path = save_checkpoint(case, &sim, &mut out, &schedule, &cfg.out_dir)?;
             output_wall += t.elapsed();
             last_checkpoint = Instant::now();
-            progress(Progress::Checkpoint { sim: &sim, path: &path });
+            progress(Progress::Checkpoint { sim: &sim, path: &path, perforation: out.perforation() });
             if interrupted {
                 return Err(RunError::Interrupted {
                     step: sim.step,
@@ -514,7 +516,7 @@ fn time_loop(
             }
         }
         if sim.step.is_multiple_of(report_every) {
-            progress(Progress::Step { sim: &sim });
+            progress(Progress::Step { sim: &sim, perforation: out.perforation() });
         }
     }
     let t = Instant::now();

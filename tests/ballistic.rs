@@ -507,11 +507,12 @@ fn a_resumed_study_continues_the_interrupted_runs_and_takes_back_the_finished() 
             (b.verdict, b.perforation, b.plug_mass, b.end_time, b.fastest, b.steps)
         );
     };
-    // Progress reports every 4 us (10 % of the end time).
+    // Progress reports every 2 us (10 % of the end time), so some come
+    // after the plug is cut (at about 9 us of the 11 us the run takes).
     let short = |name: &str| {
         let mut s = setup(name, 1);
-        s.case.time.end = 40.0e-6;
-        s.max_time = 40.0e-6;
+        s.case.time.end = 20.0e-6;
+        s.max_time = 20.0e-6;
         // a history row at every step, so one at the interrupt's checkpoint
         s.case.output.history_every = 1;
         s
@@ -539,9 +540,9 @@ fn a_resumed_study_continues_the_interrupted_runs_and_takes_back_the_finished() 
     .unwrap();
     assert!(study.interrupted && study.shots.is_empty() && study.not_started.is_empty());
     // the report carries the projectile's speed along its flight: slowed
-    // by the plate at 4 us, still moving on
+    // by the plate at 2 us, still moving on
     let along = reported.flatten().expect("the projectile's speed in the progress report");
-    assert!(along > 0.5 * speed && along < speed, "{along} m/s at 4 us of a {speed} m/s impact");
+    assert!(along > 0.5 * speed && along < speed, "{along} m/s at 2 us of a {speed} m/s impact");
     let dir = plugsim::ballistic::run_dir(&s.out_dir, speed);
     assert!(!dir.join(plugsim::ballistic::SHOT_FILE).exists());
     // the stopped run, where its checkpoint left it: the history's last
@@ -555,6 +556,8 @@ fn a_resumed_study_continues_the_interrupted_runs_and_takes_back_the_finished() 
     assert!(at.speed <= along && at.speed > 0.5 * speed, "{at:?}");
     assert_eq!(at.force, column("projectile_f_axial"), "the history's sample");
     assert_eq!(at.speed, -column("projectile_vy"), "the history's sample (the flight is along -y)");
+    let cut = Some(column("perforation_time")).filter(|&t| t > 0.0);
+    assert_eq!(paused.perforation, cut, "the plug's state at the checkpoint is the history's");
 
     // Resumed: continues from the checkpoint, to the reference's result.
     s.interrupt = None;
@@ -566,9 +569,21 @@ fn a_resumed_study_continues_the_interrupted_runs_and_takes_back_the_finished() 
         Event::Resumed { time, .. } => Some(*time),
         _ => None,
     });
-    assert!(resumed_at.is_some_and(|t| t >= 4.0e-6 && t < reference.end_time), "{resumed_at:?}");
+    assert!(resumed_at.is_some_and(|t| t >= 2.0e-6 && t < reference.end_time), "{resumed_at:?}");
     assert_eq!(resumed_at, Some(paused.time), "continues where the report said it stopped");
     same(&study.shots[0], &reference);
+    // Each progress report carries the plug's cut once it has happened
+    // (the threshold of a held run drops from 5 % to 1 % then), none before.
+    let cut_at = reference.perforation.expect("the reference cut a plug");
+    let mut after = 0;
+    for e in &events {
+        if let Event::Advanced { time, perforation, .. } = e {
+            let expected = (*time >= cut_at).then_some(cut_at);
+            assert_eq!(*perforation, expected, "the report at {time:e} s (plug cut at {cut_at:e} s)");
+            after += usize::from(perforation.is_some());
+        }
+    }
+    assert!(after > 0, "a report after the cut at {cut_at:e} s: {events:?}");
     assert!(dir.join(plugsim::ballistic::SHOT_FILE).exists());
     let history = std::fs::read(dir.join("history.csv")).unwrap();
     assert_eq!(
@@ -585,7 +600,7 @@ fn a_resumed_study_continues_the_interrupted_runs_and_takes_back_the_finished() 
     assert_eq!(again.shots, study.shots, "the whole row, wall time included");
 
     // Another case (a later max time) or no --resume: runs afresh.
-    for (max_time, resume) in [(50.0e-6, true), (40.0e-6, false)] {
+    for (max_time, resume) in [(50.0e-6, true), (20.0e-6, false)] {
         s.max_time = max_time;
         s.resume = resume;
         let mut events = Vec::new();

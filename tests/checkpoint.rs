@@ -51,7 +51,7 @@ fn run_until(case: &Case, dir: &Path, step: u64) -> PathBuf {
     let flag = Arc::new(AtomicBool::new(false));
     let stop = flag.clone();
     let err = execute(case, &config(dir, Some(flag)), &mut |p| {
-        if let Progress::Step { sim } = p {
+        if let Progress::Step { sim, .. } = p {
             if sim.step >= step {
                 stop.store(true, Ordering::SeqCst);
             }

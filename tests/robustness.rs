@@ -150,6 +150,35 @@ fn no_runs_side_by_side_is_refused() {
     assert!(!out_dir.exists(), "nothing ran: {stderr}");
 }
 
+/// An impact at or above a body's elastic wave speed (a speed in mm/s, say)
+/// is refused before any run, in a case file and as `plugsim ballistic`'s
+/// speeds, naming the field or option and the body whose wave it outruns.
+#[test]
+fn a_speed_past_the_elastic_wave_is_refused() {
+    // steel: c_L = sqrt((K + 4G/3)/rho) about 5.9 km/s; 50 m/s runs
+    let path = write_case("hypervelocity", STRIKE);
+    let line = refused(&path, &["--set", "bodies.plate.initial_velocity.0.velocity=[0.0, -5.0e4]"], "hypervelocity");
+    assert!(
+        line.contains("bodies[0].initial_velocity[0].velocity") && line.contains("'plate'") && line.contains("m/s"),
+        "{line}"
+    );
+    for (extra, option) in [
+        (&["--speeds", "300,1e9"][..], "--speeds: 1000000000 m/s"),
+        (&["--limit", "--hi", "6000"][..], "--hi: 6000 m/s"),
+        (
+            &["--set", "rigid_bodies.projectile.velocity=[0.0, -3.0e5]", "--speeds", "300"][..],
+            "rigid_bodies[0].velocity",
+        ),
+    ] {
+        let out_dir = scratch("hypervelocity-ballistic").join("out");
+        let out = out_dir.display().to_string();
+        let args = [&["ballistic", "--case", "borvik-1-axisymmetric-nonlocal", "--out", &out][..], extra].concat();
+        let line = one_error_line(&plugsim(&args));
+        assert!(line.contains(option) && line.contains("elastic wave speed of body 'plate'"), "{line}");
+        assert!(!out_dir.exists(), "nothing ran: {line}");
+    }
+}
+
 #[test]
 fn unknown_material_and_body_are_named() {
     let path = write_case("unknown-material", &STRIKE.replace("material = \"steel\"", "material = \"unobtainium\""));
