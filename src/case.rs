@@ -871,7 +871,6 @@ impl Case {
         p
     }
 
-    /// The material named `name`: from this file, else a built-in.
     /// The fastest impact the model describes, m/s, and the body that sets
     /// it: the lowest elastic longitudinal wave speed `c_L` of the deformable
     /// bodies' materials (`None` where no body's material is known and
@@ -904,6 +903,7 @@ impl Case {
         })
     }
 
+    /// The material named `name`: from this file, else a built-in.
     pub fn material(&self, name: &str) -> Option<Material> {
         match self.materials.get(name) {
             Some(spec) => Some(spec.to_material()),

@@ -702,14 +702,13 @@ fn ballistic(
             );
         }
     }
-    if args.limit {
-        let (_, impact) = plugsim::ballistic::flight(&case, projectile);
-        plugsim::ballistic::check_search(args.bounds(impact), args.tol)?;
+    let bounds = args.limit.then(|| args.bounds(plugsim::ballistic::flight(&case, projectile).1));
+    if let Some(bounds) = bounds {
+        plugsim::ballistic::check_search(bounds, args.tol)?;
     }
     // The speeds as the case's own velocity is checked (`Case::speed_problem`);
     // the search's bounds are the highest speeds it asks for.
     let asked = speeds.iter().map(|&v| ("--speeds", v));
-    let bounds = args.limit.then(|| args.bounds(plugsim::ballistic::flight(&case, projectile).1));
     let searched = bounds.into_iter().flat_map(|(lo, hi)| [("--lo", lo), ("--hi", hi)]);
     if let Some((option, problem)) = asked.chain(searched).find_map(|(o, v)| Some((o, case.speed_problem(v)?))) {
         bail!("{option}: {problem}");
