@@ -694,7 +694,7 @@ impl Case {
             validate_grid(&mut add, &format!("{k}.rectangle"), &body.rectangle, self.geometry.mode);
             for (j, iv) in body.initial_velocity.iter().enumerate() {
                 finite2(&mut add, &format!("{k}.initial_velocity[{j}].velocity"), iv.velocity, "m/s");
-                if let Some(message) = self.speed_problem(norm2(iv.velocity)) {
+                if let Some(message) = self.speed_problem(Vec2::from(iv.velocity).norm()) {
                     add(format!("{k}.initial_velocity[{j}].velocity"), message);
                 }
                 if let Some(r) = &iv.region {
@@ -752,7 +752,7 @@ impl Case {
                 }
             }
             finite2(&mut add, &format!("{k}.velocity"), rb.velocity, "m/s");
-            if let Some(message) = self.speed_problem(norm2(rb.velocity)) {
+            if let Some(message) = self.speed_problem(Vec2::from(rb.velocity).norm()) {
                 add(format!("{k}.velocity"), message);
             }
         }
@@ -1170,11 +1170,6 @@ fn non_negative(add: &mut impl FnMut(String, String), key: &str, v: Real, unit: 
     if !(v.is_finite() && v >= 0.0) {
         add(key.to_string(), format!("must be zero or positive (in {unit}), got {v}"));
     }
-}
-
-/// The length of a vector given as `[x, y]`.
-fn norm2(v: [Real; 2]) -> Real {
-    v[0].hypot(v[1])
 }
 
 fn finite2(add: &mut impl FnMut(String, String), key: &str, v: [Real; 2], unit: &str) {

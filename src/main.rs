@@ -897,14 +897,12 @@ fn one_study(
             Event::Advanced { speed, time, end, along, perforation } => {
                 // what decides a held run (`residual`): the end time is only a bound
                 let held = plugsim::residual::held_below(speed, perforation.is_some());
+                let (cut, rule) = match perforation {
+                    None => (String::new(), " with no plug"),
+                    Some(t) => (format!(", plug cut at {:.1} us", t * 1e6), ""),
+                };
                 let along = along
-                    .map(|v| match perforation {
-                        None => format!(", projectile at {v:.1} m/s (held once under {held:.1} with no plug)"),
-                        Some(t) => format!(
-                            ", projectile at {v:.1} m/s, plug cut at {:.1} us (held once under {held:.1})",
-                            t * 1e6
-                        ),
-                    })
+                    .map(|v| format!(", projectile at {v:.1} m/s{cut} (held once under {held:.1}{rule})"))
                     .unwrap_or_default();
                 eprintln!("[{at:6.0} s]   {speed:.2} m/s at {:.1} of {:.1} us{along}", time * 1e6, end * 1e6)
             }
