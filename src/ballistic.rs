@@ -64,7 +64,7 @@
 //!   flight, and those only up to their checkpoint.
 
 use crate::case::Case;
-use crate::convergence::{self, richardson, spread, step};
+use crate::convergence::{self, richardson, spread_within, step};
 use crate::io::{IoError, LinePlot, PlotError, Series};
 use crate::math::{Real, Vec2};
 use crate::residual::Verdict;
@@ -1770,7 +1770,8 @@ fn levels<'a>(rungs: &'a [Rung], speeds: &[Real]) -> Vec<Level<'a>> {
 /// The resolutions side by side, as (Markdown, CSV): per rung the ballistic
 /// limit, the Recht–Ipson fit, the residual velocity at each of `speeds`
 /// and the projectile's edge against its columns ([`edge_phase`]), then
-/// the spread of each across the rungs ([`spread`]), the last
+/// the spread of each across the rungs (with, for values that are
+/// brackets, the least and most it can be within them: [`spread_within`]), the last
 /// refinement's [`step`] (from the second-finest rung to the finest:
 /// what one more refinement moved, the usual test of a converged result)
 /// and, with three rungs or more, what the three finest say of the answer
@@ -1860,13 +1861,22 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
         let wall: Real = l.members.iter().flat_map(|r| &r.study.shots).map(|s| s.wall).fold(0.0, |t, w| t + w);
         md.push_str(&format!(" {runs} | {wall:.0} | all |\n"));
     }
-    let pct = |s: Option<Real>| s.map_or("—".into(), |x| format!("{:.1} %", 100.0 * x));
-    let values = |f: &dyn Fn(&Level) -> Option<(Real, Real)>| -> Option<Vec<Real>> {
-        levels.iter().map(|l| f(l).map(|x| x.0)).collect()
+    let pct = |x: Real| format!("{:.1} %", 100.0 * x);
+    // The spread of the values, and within their brackets where they have
+    // some (as the step's cell gives it).
+    let spread_cell = |f: &dyn Fn(&Level) -> Option<(Real, Real)>| -> String {
+        let values: Option<Vec<(Real, Real)>> = levels.iter().map(f).collect();
+        match values.as_deref().map(|v| (v, spread_within(v))) {
+            Some((v, Some((mid, least, most)))) if v.iter().any(|x| x.1 > 0.0) => {
+                format!("{} ({}…{})", pct(mid), pct(least), pct(most))
+            }
+            Some((_, Some((mid, ..)))) => pct(mid),
+            _ => "—".into(),
+        }
     };
-    md.push_str(&format!("| spread | | {} | |", pct(values(&|l| l.limit).and_then(|x| spread(&x)))));
+    md.push_str(&format!("| spread | | {} | |", spread_cell(&|l| l.limit)));
     for k in 0..speeds.len() {
-        md.push_str(&format!(" {} |", pct(values(&|l| l.residuals[k]).and_then(|x| spread(&x)))));
+        md.push_str(&format!(" {} |", spread_cell(&|l| l.residuals[k])));
     }
     md.push_str(" | | |\n");
     // The two finest resolutions, by rows (the order given need not be).
@@ -1957,7 +1967,8 @@ pub fn write_ladder_files(
     let (md, csv) = ladder_table(rungs, speeds);
     let mut text = format!("# Ballistic study at {}\n\n{header}\n\n{md}\n", ladder_extent(rungs));
     text.push_str(
-        "Spread: (max − min) / mean over the resolutions. Step: the change from the second-finest resolution to \
+        "Spread: (max − min) / mean over the resolutions (for bracketed values, with the least and most it can \
+         be within the brackets, relative to the same mean). Step: the change from the second-finest resolution to \
          the finest, relative to the former (for a limit, with the least and most it can be within the two \
          brackets). Richardson (three resolutions or more): from the three finest, the observed order of \
          convergence p, the value extrapolated to zero spacing and the grid convergence index of the finest \
@@ -2586,7 +2597,10 @@ mod tests {
         let line = |start: &str| md.lines().find(|l| l.starts_with(start)).unwrap_or_else(|| panic!("{start}: {md}"));
         assert!(line("| 24 rows, 2 phases |").contains("| 122.00 ± 4.00 | | 105.00 ± 5.00 | 2 |"), "{md}");
         assert!(line("| 48 rows, 2 phases |").contains("| 121.00 ± 2.00 | | 105.00 ± 1.00 |"), "{md}");
-        assert!(line("| spread").starts_with("| spread | | 0.8 % | | 0.0 % |"), "{md}");
+        // within the brackets: 118–126 and 119–123 overlap, so at least 0,
+        // and at most (126 − 118)/121.5 = 6.6 %; the residuals 100–110 and
+        // 104–106: 0 and 10/105 = 9.5 %
+        assert!(line("| spread").starts_with("| spread | | 0.8 % (0.0 %…6.6 %) | | 0.0 % (0.0 %…9.5 %) |"), "{md}");
         let step = line("| step 24 → 48 rows");
         assert!(step.contains("| -0.8 % (-5.6 %…+4.2 %) |") && step.contains("| +0.0 % (-5.5 %…+6.0 %) |"), "{step}");
         // one phase per resolution reads as before: no envelope line
@@ -2629,10 +2643,14 @@ mod tests {
             csv.lines().nth(1).unwrap().ends_with(",0.1800") && csv.lines().nth(2).unwrap().ends_with(','),
             "{csv}"
         );
-        // limits 120 and 130: 10/125 = 8.0 %; at 200 m/s 100 and 110: 10/105 = 9.5 %; at 300 m/s 0 %
+        // limits 120 ± 1 and 130 ± 1: 10/125 = 8.0 %, within the brackets
+        // 8/125 = 6.4 % to 12/125 = 9.6 %; at 200 m/s 100 and 110: 10/105 =
+        // 9.5 %; at 300 m/s 0 % (residuals have no bracket)
         let spread_row = md.lines().find(|l| l.starts_with("| spread")).unwrap();
         assert!(
-            spread_row.contains("| 8.0 % |") && spread_row.contains("| 9.5 % |") && spread_row.contains("| 0.0 % |"),
+            spread_row.contains("| 8.0 % (6.4 %…9.6 %) |")
+                && spread_row.contains("| 9.5 % |")
+                && spread_row.contains("| 0.0 % |"),
             "{md}"
         );
         // From 12 to 24 rows: the limit 120 ± 1 → 130 ± 1 is +8.3 %, and
@@ -2647,7 +2665,7 @@ mod tests {
         // A held run has no residual to compare: "held", and no spread at that speed.
         let rungs = [rung(12, (119.0, 121.0), held, 250.0), rung(24, (129.0, 131.0), perf(110.0), 250.0)];
         let (md, _) = ladder_table(&rungs, &[200.0]);
-        assert!(md.contains("| held |") && md.contains("| 8.0 % | | — |"), "{md}");
+        assert!(md.contains("| held |") && md.contains("| 8.0 % (6.4 %…9.6 %) | | — |"), "{md}");
         // The step is between the two finest rungs whatever the order given.
         let rungs = [
             rung(48, (124.0, 126.0), perf(100.0), 250.0),

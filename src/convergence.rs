@@ -3,7 +3,8 @@
 //! is refined, and what the moves say about the answer at zero spacing.
 //!
 //! - [`spread`]: `(max − min) / mean` over the rungs, issue #19's measure
-//!   of "the same answer at every resolution".
+//!   of "the same answer at every resolution"; [`spread_within`] gives
+//!   with it the least and most it can be when each value is a bracket.
 //! - [`step`]: the change from one rung to the next, with the least and
 //!   most it can be when each value is a bracket (a bisected limit).
 //! - [`richardson`]: from the three finest rungs, the observed order of
@@ -30,6 +31,22 @@ pub fn spread(values: &[Real]) -> Option<Real> {
     }
     let (lo, hi) = values.iter().fold((Real::MAX, Real::MIN), |(a, b), &x| (a.min(x), b.max(x)));
     Some((hi - lo) / (values.iter().sum::<Real>() / values.len() as Real))
+}
+
+/// [`spread`] of values each given as (value, half-width of its bracket):
+/// (central, least, most). The central spread is that of the values; the
+/// least and most are the smallest and largest `max − min` that values
+/// anywhere in their brackets can give (the least 0 where every bracket
+/// shares a point), each relative to the mean of the values. `None` for
+/// fewer than two.
+pub fn spread_within(values: &[(Real, Real)]) -> Option<(Real, Real, Real)> {
+    let central = spread(&values.iter().map(|v| v.0).collect::<Vec<_>>())?;
+    let mean = values.iter().map(|v| v.0).sum::<Real>() / values.len() as Real;
+    let highest_low = values.iter().map(|(v, h)| v - h).fold(Real::MIN, Real::max);
+    let lowest_high = values.iter().map(|(v, h)| v + h).fold(Real::MAX, Real::min);
+    let lowest_low = values.iter().map(|(v, h)| v - h).fold(Real::MAX, Real::min);
+    let highest_high = values.iter().map(|(v, h)| v + h).fold(Real::MIN, Real::max);
+    Some((central, (highest_low - lowest_high).max(0.0) / mean, (highest_high - lowest_low) / mean))
 }
 
 /// The change from `coarse` to `fine` relative to `coarse`, each given as
@@ -241,6 +258,23 @@ mod tests {
     fn spread_and_step_by_hand() {
         assert_eq!(spread(&[1.0]), None);
         assert!((spread(&[90.0, 110.0]).unwrap() - 0.2).abs() < 1e-15);
+        assert_eq!(spread_within(&[(1.0, 0.5)]), None);
+        // Case II's plate at 24 / 48 / 72 rows (docs/validation.md): the
+        // middles 173.23 / 176.93 / 175.85 m/s are 3.70 / 175.337 = 2.1 %
+        // apart; the brackets' nearest ends, 173.71 and 175.85, 1.2 %, and
+        // their farthest, 172.75 and 178.01, 3.0 %.
+        let (mid, least, most) = spread_within(&[(173.23, 0.48), (176.93, 1.08), (175.85, 2.15)]).unwrap();
+        let mean = (173.23 + 176.93 + 175.85) / 3.0;
+        assert!((mid - 3.70 / mean).abs() < 1e-12 && (100.0 * mid - 2.11).abs() < 0.01, "{mid}");
+        assert!((least - (176.93 - 1.08 - (173.23 + 0.48)) / mean).abs() < 1e-12, "{least}");
+        assert!((most - (176.93 + 1.08 - (173.23 - 0.48)) / mean).abs() < 1e-12, "{most}");
+        assert!((100.0 * least - 1.22).abs() < 0.01 && (100.0 * most - 3.00).abs() < 0.01, "{least} {most}");
+        // brackets that overlap can all hold one value: no least spread
+        let (mid, least, most) = spread_within(&[(100.0, 2.0), (103.0, 2.0)]).unwrap();
+        assert!((mid - 3.0 / 101.5).abs() < 1e-15 && least == 0.0 && (most - 7.0 / 101.5).abs() < 1e-15);
+        // exact values: all three the same
+        let (mid, least, most) = spread_within(&[(90.0, 0.0), (110.0, 0.0)]).unwrap();
+        assert!((mid - 0.2).abs() < 1e-15 && least == mid && most == mid);
         let (mid, least, most) = step((100.0, 1.0), (98.0, 0.5));
         assert!((mid + 0.02).abs() < 1e-15);
         assert!((least - (97.5 - 101.0) / 101.0).abs() < 1e-15);
