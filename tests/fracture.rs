@@ -10,7 +10,7 @@ use plugsim::bulk_viscosity::BulkViscosity;
 use plugsim::case::Case;
 use plugsim::contact::{SlaveSet, SurfaceDetection};
 use plugsim::fracture::growth::nodal_mass;
-use plugsim::fracture::{CrackGrowth, Criterion, EventKind, FractureParameters, TipDirection};
+use plugsim::fracture::{CrackGrowth, Criterion, EventKind, FractureParameters, TipDirection, TipGate};
 use plugsim::geometry::GeometryMode;
 use plugsim::material::{Elastic, Material};
 use plugsim::math::{Block2, Real, Vec2};
@@ -410,6 +410,31 @@ fn one_crack_nucleates_per_failed_zone() {
     assert!(two.iter().any(|&x| x < 13.0) && two.iter().any(|&x| x > 25.0), "{two:?}");
 }
 
+/// A crack started at the top centre of a 21 × 13 strip failed along its
+/// centre column, grown by 16 stages under the Kirchhoff stress
+/// `tau(X)` at every point and the gate of `gate` (with `ℓ` = 2
+/// spacings): whether it arrested, and where its tip stands (spacings
+/// above the bottom; `None` once arrested).
+fn gated_tip(tau: impl Fn(&Vec2) -> nalgebra::Matrix3<Real>, gate: FractureParameters) -> (bool, Option<Real>) {
+    let (nx, ny) = (21, 13);
+    let mut m = plate(nx, ny);
+    set_field(&mut m, |x| if (x.x - 10.0 * H).abs() < 0.6 * H { 0.6 } else { 0.1 });
+    for q in 0..m.quad.len() {
+        m.quad.tau[q] = Block2::block_part(&tau(&m.quad.x0[q]));
+    }
+    let mut g = CrackGrowth::new(FractureParameters { nonlocal_radius: 2.0 * H, ..gate });
+    let start = [id(&m, 10, ny - 1), id(&m, 10, ny - 2)];
+    g.insert_crack(&mut m, &start, false).unwrap();
+    drive(&mut m, &mut g, 16);
+    let tip = g.cracks[0].tip.map(|t| m.particles.x0[t].y / H);
+    (g.cracks[0].arrested.is_some(), tip)
+}
+
+/// Shear `1e8 Pa` on the in-plane axes plus the mean stress `p`, Pa.
+fn shear_plus(p: Real) -> nalgebra::Matrix3<Real> {
+    nalgebra::Matrix3::new(0.0, 1e8, 0.0, 1e8, 0.0, 0.0, 0.0, 0.0, 0.0) + nalgebra::Matrix3::identity() * p
+}
+
 /// `nonlocal_tip_triaxiality`: the tip's compression gate reads the
 /// triaxiality averaged over `ℓ` (ratio of the averaged mean and von
 /// Mises stresses). In a uniform stress state the average is the state's
@@ -420,30 +445,19 @@ fn one_crack_nucleates_per_failed_zone() {
 /// particle's gate stops it.
 #[test]
 fn the_tip_gate_over_a_length() {
-    let (nx, ny) = (21, 13);
-    let top = (ny - 1) as Real * H;
-    let run = |mean: Real, below_only: bool, gate: Real, nonlocal: bool| {
-        let mut m = plate(nx, ny);
-        set_field(&mut m, |x| if (x.x - 10.0 * H).abs() < 0.6 * H { 0.6 } else { 0.1 });
-        let shear = nalgebra::Matrix3::new(0.0, 1e8, 0.0, 1e8, 0.0, 0.0, 0.0, 0.0, 0.0);
-        for q in 0..m.quad.len() {
-            let p = if !below_only || m.quad.x0[q].y < top - 3.5 * H { mean } else { 0.0 };
-            m.quad.tau[q] = Block2::block_part(&(shear + nalgebra::Matrix3::identity() * (p * 3f64.sqrt() * 1e8)));
-        }
-        let mut g = CrackGrowth::new(FractureParameters {
+    let top = 12.0 * H;
+    let run = |eta: Real, below_only: bool, gate: Real, nonlocal: bool| {
+        // shear 1e8 has σ_eq = √3·1e8: the mean stress for triaxiality `eta`
+        let tau = |x: &Vec2| shear_plus(if !below_only || x.y < top - 3.5 * H { eta * 3f64.sqrt() * 1e8 } else { 0.0 });
+        let p = FractureParameters {
             tip_min_triaxiality: gate,
             nonlocal_tip_triaxiality: nonlocal,
-            nonlocal_radius: 2.0 * H,
             ..params(Criterion::EffectiveStrain)
-        });
-        let start = [id(&m, 10, ny - 1), id(&m, 10, ny - 2)];
-        g.insert_crack(&mut m, &start, false).unwrap();
-        drive(&mut m, &mut g, 16);
-        let tip = g.cracks[0].tip.map(|t| m.particles.x0[t].y / H);
-        (g.cracks[0].arrested.is_some(), tip)
+        };
+        gated_tip(tau, p)
     };
     let third = -1.0 / 3.0;
-    let start = Some((ny - 2) as Real);
+    let start = Some(11.0);
     assert_eq!(run(-0.5, false, third, true), (false, start), "uniform -1/2 under -1/3: no step");
     assert!(run(-0.5, false, -0.6, true).0, "uniform -1/2 under -0.6: through");
     let (arrested, own) = run(-1.0, true, third, false);
@@ -455,6 +469,39 @@ fn the_tip_gate_over_a_length() {
     let (own, averaged) = (own.unwrap(), averaged.unwrap());
     for tip in [own, averaged] {
         assert!((8.5 - 2.0..=8.5 + 2.0 + 2.5).contains(&tip), "stopped at {tip} spacings");
+    }
+}
+
+/// `tip_gate = "tension"`: the tip steps only where the largest principal
+/// stress is tensile, the sign of Cockcroft–Latham's `⟨σ₁⟩`, whatever the
+/// triaxiality. Shear `τ` under a pressure `p` has `σ₁ = τ − p` and
+/// `σ_m/σ_eq = −p/(√3 τ)`: at `p = 0.8 τ` (−0.46, under −1/3) the
+/// triaxiality gate stops the tip and the tension gate lets it through; at
+/// `p = 1.2 τ` (`σ₁ < 0`, −0.69) both stop it. An in-plane pressure of
+/// 3 with a hoop tension of 0.5 (in units of `τ`; −0.52, `σ₁` = 0.5 > 0)
+/// passes the tension gate only. The same at the particle's own point and
+/// over `ℓ`, as a uniform state's average is the state.
+#[test]
+fn the_tension_gate_reads_the_largest_principal_stress() {
+    let hoop = nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::new(-3e8, -3e8, 0.5e8));
+    for nonlocal in [false, true] {
+        let run = |tau: nalgebra::Matrix3<Real>, gate: TipGate| {
+            let p = FractureParameters {
+                tip_gate: gate,
+                nonlocal_tip_triaxiality: nonlocal,
+                ..params(Criterion::EffectiveStrain)
+            };
+            gated_tip(|_| tau, p).0
+        };
+        for (tau, triaxiality, tension, what) in [
+            (shear_plus(-0.8e8), false, true, "shear under 0.8 of its pressure"),
+            (shear_plus(-1.2e8), false, false, "shear under 1.2 of its pressure"),
+            (hoop, false, true, "in-plane pressure with hoop tension"),
+            (shear_plus(0.0), true, true, "pure shear"),
+        ] {
+            assert_eq!(run(tau, TipGate::Triaxiality), triaxiality, "{what}, triaxiality gate, nonlocal {nonlocal}");
+            assert_eq!(run(tau, TipGate::Tension), tension, "{what}, tension gate, nonlocal {nonlocal}");
+        }
     }
 }
 

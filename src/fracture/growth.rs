@@ -9,10 +9,10 @@ use super::geometry::{
 };
 use super::nonlocal::NonlocalAverage;
 use super::visibility::{CrackSegments, CrackVisibility};
-use super::{tip_speed, Criterion, FractureError, FractureParameters, TipDirection};
+use super::{tip_speed, Criterion, FractureError, FractureParameters, TipDirection, TipGate};
 use crate::geometry::GeometryMode;
 use crate::material::Constitutive;
-use crate::math::{Block2, Real, Tensor3, Vec2};
+use crate::math::{largest_principal, Block2, Real, Tensor3, Vec2};
 use crate::model::{Gather, Model};
 use crate::neighbors::CellGrid;
 use crate::particles::{FaceSide, ParticleFlags};
@@ -511,6 +511,27 @@ impl CrackGrowth {
         triaxiality_of(sums)
     }
 
+    /// Whether a crack tip may step into candidate `i` by its stress
+    /// ([`TipGate`]): its triaxiality ([`Self::tip_triaxiality`]) at least
+    /// `tip_min_triaxiality`, or with `tip_gate = "tension"` a tensile
+    /// largest principal value of the Kirchhoff stress, the particle's own
+    /// (lumped) or averaged over `ℓ` as `nonlocal_tip_triaxiality` says (a
+    /// positive weighting does not change the sign of `σ₁` in a uniform
+    /// state, `the_tension_gate_reads_the_largest_principal_stress`).
+    fn tip_gate_open(&self, model: &Model, i: usize) -> bool {
+        match self.params.tip_gate {
+            TipGate::Triaxiality => self.tip_triaxiality(model, i) >= self.params.tip_min_triaxiality,
+            TipGate::Tension => {
+                let tau = if self.params.nonlocal_tip_triaxiality {
+                    self.over_length(model, i, |k| model.quad.tau[k].to_tensor()).0
+                } else {
+                    model.project_at(i, |q| model.quad.tau[q].to_tensor())
+                };
+                largest_principal(&tau) > 0.0
+            }
+        }
+    }
+
     /// The value that ranks the candidates meeting the criterion, given
     /// particle `i`'s criterion value `value`: the value itself, except
     /// with `"nonlocal_damage"`, where it is the particle's own damage
@@ -680,7 +701,7 @@ impl CrackGrowth {
                 if value < critical || best.is_some_and(|(bv, _, _)| bv >= rank) {
                     continue;
                 }
-                if self.tip_triaxiality(model, j) < self.params.tip_min_triaxiality {
+                if !self.tip_gate_open(model, j) {
                     continue;
                 }
                 if self.passes_over(model, tip, j) || self.blocked_from_tip(model, c, j) {
