@@ -497,38 +497,42 @@ impl CrackGrowth {
         })
     }
 
-    /// The triaxiality that gates a crack tip's step into candidate `i`
-    /// (`tip_min_triaxiality`): the particle's own ([`Self::triaxiality`]),
-    /// or with `nonlocal_tip_triaxiality` the ratio of the mean and von
-    /// Mises stresses averaged over `ℓ` with the weights of
-    /// [`Self::nonlocal_damage`] (module doc of [`crate::fracture`], "The
-    /// compression gate on the tip").
-    fn tip_triaxiality(&self, model: &Model, i: usize) -> Real {
-        if !self.params.nonlocal_tip_triaxiality {
-            return self.triaxiality(model, i);
+    /// The weighted sum of `f` over the quadrature points that a crack
+    /// tip's gate reads at candidate `i`: over `ℓ` with the weights of
+    /// [`Self::nonlocal_damage`] with `nonlocal_tip_triaxiality`, else the
+    /// particle's own ([`lumped_sum`]). Only ratios and signs of it are
+    /// read, so it need not be normalised.
+    fn tip_reading<T>(&self, model: &Model, i: usize, f: impl Fn(usize) -> T) -> T
+    where
+        T: Default + std::ops::AddAssign + std::ops::Mul<Real, Output = T>,
+    {
+        if self.params.nonlocal_tip_triaxiality {
+            self.over_length(model, i, f).0
+        } else {
+            lumped_sum(model, i, f)
         }
-        let (sums, _) = self.over_length(model, i, |k| mean_and_von_mises(&model.quad.tau[k]));
-        triaxiality_of(sums)
+    }
+
+    /// The triaxiality that gates a crack tip's step into candidate `i`
+    /// (`tip_min_triaxiality`): the ratio of the mean and von Mises
+    /// stresses read by [`Self::tip_reading`], the particle's own
+    /// ([`Self::triaxiality`]) or averaged over `ℓ` (module doc of
+    /// [`crate::fracture`], "The compression gate on the tip").
+    fn tip_triaxiality(&self, model: &Model, i: usize) -> Real {
+        triaxiality_of(self.tip_reading(model, i, |k| mean_and_von_mises(&model.quad.tau[k])))
     }
 
     /// Whether a crack tip may step into candidate `i` by its stress
     /// ([`TipGate`]): its triaxiality ([`Self::tip_triaxiality`]) at least
     /// `tip_min_triaxiality`, or with `tip_gate = "tension"` a tensile
-    /// largest principal value of the Kirchhoff stress, the particle's own
-    /// (lumped) or averaged over `ℓ` as `nonlocal_tip_triaxiality` says (a
-    /// positive weighting does not change the sign of `σ₁` in a uniform
-    /// state, `the_tension_gate_reads_the_largest_principal_stress`).
+    /// largest principal value of the Kirchhoff stress read by
+    /// [`Self::tip_reading`] (a positive weighting does not change the
+    /// sign of `σ₁` in a uniform state,
+    /// `the_tension_gate_reads_the_largest_principal_stress`).
     fn tip_gate_open(&self, model: &Model, i: usize) -> bool {
         match self.params.tip_gate {
             TipGate::Triaxiality => self.tip_triaxiality(model, i) >= self.params.tip_min_triaxiality,
-            TipGate::Tension => {
-                let tau = if self.params.nonlocal_tip_triaxiality {
-                    self.over_length(model, i, |k| model.quad.tau[k].to_tensor()).0
-                } else {
-                    model.project_at(i, |q| model.quad.tau[q].to_tensor())
-                };
-                largest_principal(&tau) > 0.0
-            }
+            TipGate::Tension => largest_principal(&self.tip_reading(model, i, |k| model.quad.tau[k].to_tensor())) > 0.0,
         }
     }
 
@@ -617,12 +621,7 @@ impl CrackGrowth {
     /// lumped projections of the quadrature points' mean and von Mises
     /// stresses (the same weights as [`Self::criterion_value`]).
     pub fn triaxiality(&self, model: &Model, i: usize) -> Real {
-        let mut sums = Vec2::zeros();
-        for j in model.gather.range(i) {
-            let q = model.gather.point[j] as usize;
-            sums += mean_and_von_mises(&model.quad.tau[q]) * (model.gather.value[j] * model.quad.weight[q]);
-        }
-        triaxiality_of(sums)
+        triaxiality_of(lumped_sum(model, i, |q| mean_and_von_mises(&model.quad.tau[q])))
     }
 
     /// How far along its locus the material was where the cracks grew:
@@ -1502,6 +1501,20 @@ pub fn live_share(model: &Model, i: usize) -> Real {
 
 /// A stress's mean and von Mises values `(τ_m, τ̄)`, the two sums a
 /// triaxiality is the ratio of.
+/// `Σ_q N_i(X_q) w_q f(q)` over particle `i`'s gather: the lumped
+/// projection's numerator, unnormalised (for ratios and signs).
+fn lumped_sum<T>(model: &Model, i: usize, f: impl Fn(usize) -> T) -> T
+where
+    T: Default + std::ops::AddAssign + std::ops::Mul<Real, Output = T>,
+{
+    let mut sum = T::default();
+    for j in model.gather.range(i) {
+        let q = model.gather.point[j] as usize;
+        sum += f(q) * (model.gather.value[j] * model.quad.weight[q]);
+    }
+    sum
+}
+
 fn mean_and_von_mises(tau: &Block2) -> Vec2 {
     Vec2::new(tau.trace() / 3.0, tau.von_mises())
 }
