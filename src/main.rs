@@ -47,6 +47,21 @@ enum Command {
         /// The run's output directory (holding `checkpoints/`).
         dir: PathBuf,
     },
+    /// Why the growing crack tips of a run stand where they are: every particle within
+    /// reach of each tip, its criterion value, its rank, the tip's gate reading there and
+    /// the first check of the crack-growth stage that turns it down, read from a checkpoint.
+    CrackTips {
+        /// A run's output directory (its newest checkpoint) or a checkpoint file (.ckpt).
+        path: PathBuf,
+        /// Read the tips with other crack-tip parameters than the run's, e.g.
+        /// --set fracture.nonlocal_tip_triaxiality=false (fracture.* keys only; repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// List the particles outside the tip's fan too (their criterion and gate
+        /// readings: what a wider fan would find).
+        #[arg(long)]
+        all: bool,
+    },
     /// Check a case file without running it: validation, particle counts, time step.
     Check {
         case_file: Option<PathBuf>,
@@ -233,6 +248,91 @@ fn list_cases() -> Result<()> {
     }
 }
 
+/// `plugsim crack-tips`: the candidates of every growing tip of the
+/// checkpoint at `path` (a file, or a run directory's newest), those
+/// outside the fan too with `all`.
+fn crack_tips(path: &Path, set: &[String], all: bool) -> Result<()> {
+    let restored = if path.is_dir() {
+        let (r, warnings) = plugsim::checkpoint::read_latest(path)?;
+        for w in warnings {
+            eprintln!("warning: {w}");
+        }
+        r
+    } else {
+        plugsim::checkpoint::read(path)?
+    };
+    let mut sim = restored.sim;
+    println!("{} at t = {:.3} us (step {})", restored.path.display(), sim.time * 1e6, sim.step);
+    let Some(cracks) = sim.cracks.as_mut() else {
+        println!("the case grows no cracks");
+        return Ok(());
+    };
+    if let Some(key) = set.iter().find(|s| !s.starts_with("fracture.")) {
+        bail!("--set {key}: crack-tips reads the tips again with other fracture.* parameters only");
+    }
+    if !set.is_empty() {
+        let text = toml::to_string(&restored.case).context("writing the checkpoint's case back")?;
+        let case = Case::from_str_with(&text, &restored.path.display().to_string(), set)?;
+        // the caches the parameters shape (the circle grid, the average's
+        // bins) are not in checkpoints: built at first use, with these
+        cracks.params = case.fracture;
+        println!("read with {}", set.join(" "));
+    }
+    let model = &sim.model;
+    let growing: Vec<usize> = (0..cracks.cracks.len()).filter(|&c| cracks.cracks[c].growing()).collect();
+    println!(
+        "{} cracks, {} growing; tip gate {:?}, read {}",
+        cracks.cracks.len(),
+        growing.len(),
+        cracks.params.tip_gate,
+        if cracks.params.nonlocal_tip_triaxiality { "over the nonlocal radius" } else { "at the particle" }
+    );
+    for c in growing {
+        let crack = &cracks.cracks[c];
+        let tip = crack.tip.expect("growing");
+        let (x0, x) = (model.particles.x0[tip], model.particles.x0[tip] + model.particles.u[tip]);
+        let last = crack.vertices.len();
+        println!(
+            "\ncrack {c}: tip particle {tip} at X = ({:.4}, {:.4}) mm (now ({:.4}, {:.4}) mm), {} vertices, direction ({:.3}, {:.3})",
+            x0.x * 1e3,
+            x0.y * 1e3,
+            x.x * 1e3,
+            x.y * 1e3,
+            last,
+            crack.direction().x,
+            crack.direction().y
+        );
+        let path: Vec<String> =
+            crack.vertices.iter().map(|v| format!("({:.3}, {:.3})", v.x0.x * 1e3, v.x0.y * 1e3)).collect();
+        println!("  path (reference, mm): {}", path.join(" "));
+        let report = cracks.tip_candidates(model, c);
+        if let Some(h) = report.heading {
+            println!("  heading ({:.3}, {:.3}): a candidate's rank is minus its angle to it, rad", h.x, h.y);
+        }
+        let mut rows = report.candidates;
+        rows.sort_by(|a, b| a.rank.is_nan().cmp(&b.rank.is_nan()).then(b.rank.total_cmp(&a.rank)));
+        let chosen = rows.iter().find(|r| r.check == plugsim::fracture::CandidateCheck::Eligible).map(|r| r.particle);
+        println!(
+            "  {:>8} {:>9} {:>9} {:>10} {:>9} {:>12}  check",
+            "particle", "dX mm", "dY mm", "criterion", "rank", "gate"
+        );
+        for r in rows.iter().filter(|r| all || r.check != plugsim::fracture::CandidateCheck::OutsideFan) {
+            println!(
+                "  {:>8} {:>9.4} {:>9.4} {:>10.4} {:>9.4} {:>12.4e}  {}{}",
+                r.particle,
+                r.offset.x * 1e3,
+                r.offset.y * 1e3,
+                r.value,
+                r.rank,
+                r.gate,
+                r.check.name(),
+                if Some(r.particle) == chosen { " (the step)" } else { "" }
+            );
+        }
+    }
+    Ok(())
+}
+
 fn dispatch(cmd: Command) -> Result<()> {
     match cmd {
         Command::Cases => list_cases(),
@@ -279,6 +379,7 @@ fn dispatch(cmd: Command) -> Result<()> {
                 })
             })
         }
+        Command::CrackTips { path, set, all } => crack_tips(&path, &set, all),
         Command::Resume { dir } => {
             let cfg = RunConfig {
                 out_dir: dir.clone(),

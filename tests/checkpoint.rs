@@ -578,3 +578,39 @@ fn altered_checkpoints_never_panic_the_reader() {
         })
         .unwrap();
 }
+
+/// `plugsim crack-tips` reads the growing tips of a checkpoint (the fracture
+/// resume test's periodic one, where a crack grows on after it): each
+/// growing tip with its candidate table, its own faces among them as
+/// "taken"; with `--set fracture.tip_gate="tension"` the same state under
+/// the other gate; a key outside `fracture.*` refused naming it.
+#[test]
+fn crack_tips_reads_the_growing_tips_of_a_checkpoint() {
+    let case = case(BORVIK_FRACTURE, FRACTURE_SETS);
+    let dir = scratch("crack-tips");
+    let _ = run_until(&case, &dir, FRACTURE_STOP);
+    let ckpts = checkpoint::list(&checkpoint::directory(&dir));
+    let (_, periodic) = ckpts.first().cloned().expect("the periodic checkpoint");
+    let growing = checkpoint::read(&periodic).unwrap().sim.cracks.unwrap();
+    let growing = growing.cracks.iter().filter(|c| c.growing()).count();
+    assert!(growing > 0, "a crack grows at the checkpoint");
+    let text = |args: &[&str]| {
+        let out = plugsim(args);
+        (
+            out.status.success(),
+            String::from_utf8_lossy(&out.stdout).into_owned(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    let file = periodic.to_str().unwrap();
+    let (ok, stdout, stderr) = text(&["crack-tips", file]);
+    assert!(ok, "{stderr}");
+    assert_eq!(stdout.matches(": tip particle ").count(), growing, "{stdout}");
+    assert!(stdout.contains("tip gate Triaxiality"), "{stdout}");
+    assert!(stdout.lines().any(|l| l.trim_end().ends_with(" taken")), "the crack's own faces: {stdout}");
+    let (ok, stdout, stderr) = text(&["crack-tips", file, "--set", "fracture.tip_gate=\"tension\""]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("tip gate Tension") && stdout.contains("read with fracture.tip_gate"), "{stdout}");
+    let (ok, _, stderr) = text(&["crack-tips", file, "--set", "time.end=1e-6"]);
+    assert!(!ok && stderr.contains("time.end") && stderr.contains("fracture.*"), "{stderr}");
+}

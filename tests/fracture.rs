@@ -505,6 +505,77 @@ fn the_tension_gate_reads_the_largest_principal_stress() {
     }
 }
 
+/// `CrackGrowth::tip_candidates` (`plugsim crack-tips`) reports what the
+/// growth stage does: on [`gated_tip`]'s strip in pure shear (`σ₁ > 0`
+/// everywhere) under the tension gate, the eligible candidate of largest
+/// rank is the particle the tip steps to at the next stage, at each of
+/// the crack's steps; with the pressure raised to 1.2 τ, every candidate
+/// that meets the criterion reads "gate closed" with the gate's reading
+/// the state's own `σ₁ = τ − p = −2e7 Pa` (a uniform state's mean), and
+/// the tip does not move.
+#[test]
+fn tip_candidates_report_what_the_growth_stage_does() {
+    use plugsim::fracture::CandidateCheck;
+    let (nx, ny) = (21, 13);
+    let setup = |tau: nalgebra::Matrix3<Real>| {
+        let mut m = plate(nx, ny);
+        set_field(&mut m, |x| if (x.x - 10.0 * H).abs() < 0.6 * H { 0.6 } else { 0.1 });
+        for q in 0..m.quad.len() {
+            m.quad.tau[q] = Block2::block_part(&tau);
+        }
+        let mut g = CrackGrowth::new(FractureParameters {
+            nonlocal_radius: 2.0 * H,
+            tip_gate: TipGate::Tension,
+            crack_speed_fraction: 0.0,
+            ..params(Criterion::EffectiveStrain)
+        });
+        let start = [id(&m, 10, ny - 1), id(&m, 10, ny - 2)];
+        g.insert_crack(&mut m, &start, false).unwrap();
+        (m, g)
+    };
+    let best = |rows: &[plugsim::fracture::TipCandidate]| {
+        rows.iter()
+            .filter(|r| r.check == CandidateCheck::Eligible)
+            .max_by(|a, b| a.rank.total_cmp(&b.rank))
+            .map(|r| r.particle)
+    };
+    // open: each predicted step is the step taken
+    let (mut m, mut g) = setup(shear_plus(0.0));
+    let mut steps = 0;
+    for stage in 1..=16u64 {
+        let Some(tip) = g.cracks[0].tip else { break };
+        let rows = g.tip_candidates(&m, 0).candidates;
+        assert!(!rows.is_empty(), "stage {stage}: candidates within reach");
+        let predicted = best(&rows);
+        g.grow(&mut m, stage as Real * 1e-8, stage).unwrap();
+        let after = g.cracks[0].tip;
+        if after != Some(tip) && after.is_some() {
+            let reached = g.cracks[0].vertices.last().unwrap().x0;
+            let predicted = predicted.unwrap_or_else(|| panic!("stage {stage}: a step with no eligible candidate"));
+            assert!(
+                (m.particles.x0[predicted] - reached).norm() < 1e-9 * H,
+                "stage {stage}: stepped to {reached:?}, predicted {:?}",
+                m.particles.x0[predicted]
+            );
+            steps += 1;
+        }
+    }
+    assert!(steps >= 3, "the tip stepped {steps} times");
+    // closed: every candidate over the criterion is held by the gate
+    let (mut m, mut g) = setup(shear_plus(-1.2e8));
+    let tip = g.cracks[0].tip;
+    let rows = g.tip_candidates(&m, 0).candidates;
+    let over: Vec<_> = rows.iter().filter(|r| r.value >= 0.3).collect();
+    assert!(!over.is_empty(), "failed candidates in the fan");
+    for r in &over {
+        assert_eq!(r.check, CandidateCheck::GateClosed, "{r:?}");
+        assert!((r.gate + 2e7).abs() < 1e-6 * 2e7, "the mean sigma_1 {} Pa", r.gate);
+    }
+    assert_eq!(best(&rows), None);
+    drive(&mut m, &mut g, 3);
+    assert_eq!(g.cracks[0].tip, tip, "the gate holds the tip");
+}
+
 /// The vertices of the one crack grown by `calls` growth stages with
 /// `tip_direction`, on a 21 × 21 lattice failed everywhere, most at the
 /// top centre (one core there), after `prepare` has set its stress or

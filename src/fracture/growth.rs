@@ -203,6 +203,90 @@ impl TipValues {
     }
 }
 
+/// What [`CrackGrowth::grow`] makes of a particle within reach of a
+/// growing tip: the first of its checks that turns it down, in the order
+/// it makes them, or [`Self::Eligible`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CandidateCheck {
+    /// Already a crack face, or detached.
+    Taken,
+    /// Outside the fan of `θ_c` about the crack's direction.
+    OutsideFan,
+    /// Its criterion value is below the critical one.
+    BelowCriterion,
+    /// The tip's stress gate is closed there ([`super::TipGate`]).
+    GateClosed,
+    /// The step would pass over a third particle.
+    PassesOver,
+    /// A crack lies between the tip and it.
+    Blocked,
+    /// A surface particle the step would meet more obliquely than
+    /// [`MAX_SURFACE_OBLIQUITY`].
+    Oblique,
+    /// The tip may step to it.
+    Eligible,
+}
+
+impl CandidateCheck {
+    /// The check's name in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            CandidateCheck::Taken => "taken",
+            CandidateCheck::OutsideFan => "outside fan",
+            CandidateCheck::BelowCriterion => "below criterion",
+            CandidateCheck::GateClosed => "gate closed",
+            CandidateCheck::PassesOver => "passes over",
+            CandidateCheck::Blocked => "blocked",
+            CandidateCheck::Oblique => "oblique",
+            CandidateCheck::Eligible => "eligible",
+        }
+    }
+}
+
+/// One particle within reach of a growing tip
+/// ([`CrackGrowth::tip_candidates`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TipCandidate {
+    pub particle: usize,
+    /// Its reference position less the tip's, m.
+    pub offset: Vec2,
+    /// Its criterion value (NaN if taken).
+    pub value: Real,
+    /// Its rank (larger first; NaN if taken or outside the fan).
+    pub rank: Real,
+    /// What the tip's gate reads there: the triaxiality, or with
+    /// `tip_gate = "tension"` the mean largest principal stress, Pa (NaN
+    /// if taken).
+    pub gate: Real,
+    pub check: CandidateCheck,
+}
+
+/// A growing tip as [`CrackGrowth::tip_candidates`] reads it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TipReport {
+    /// Where the tip heads in the reference configuration, if its
+    /// `tip_direction` gives a heading (the candidates' rank is then
+    /// minus their angle to it).
+    pub heading: Option<Vec2>,
+    /// Every particle within reach of the tip.
+    pub candidates: Vec<TipCandidate>,
+}
+
+/// A growing tip's fan: what its candidates are measured against.
+struct TipFan {
+    tip: usize,
+    /// The tip's reference position, m.
+    xt: Vec2,
+    /// The last segment's direction.
+    d: Vec2,
+    /// The direction from the crack's start to the tip.
+    mean: Vec2,
+    /// Half the fan angle, rad.
+    half_fan: Real,
+    /// Where the tip heads ([`CrackGrowth::heading`]).
+    heading: Option<Vec2>,
+}
+
 /// A vertex of a crack path.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CrackVertex {
@@ -498,18 +582,19 @@ impl CrackGrowth {
     }
 
     /// The weighted sum of `f` over the quadrature points that a crack
-    /// tip's gate reads at candidate `i`: over `ℓ` with the weights of
-    /// [`Self::nonlocal_damage`] with `nonlocal_tip_triaxiality`, else the
-    /// particle's own ([`lumped_sum`]). Only ratios and signs of it are
-    /// read, so it need not be normalised.
-    fn tip_reading<T>(&self, model: &Model, i: usize, f: impl Fn(usize) -> T) -> T
+    /// tip's gate reads at candidate `i`, and the sum of the weights: over
+    /// `ℓ` with the weights of [`Self::nonlocal_damage`] with
+    /// `nonlocal_tip_triaxiality`, else the particle's own
+    /// ([`lumped_sum`]). The gates read only ratios and signs of the sum;
+    /// the weight turns it into a mean for [`Self::tip_candidates`].
+    fn tip_reading<T>(&self, model: &Model, i: usize, f: impl Fn(usize) -> T) -> (T, Real)
     where
         T: Default + std::ops::AddAssign + std::ops::Mul<Real, Output = T>,
     {
         if self.params.nonlocal_tip_triaxiality {
-            self.over_length(model, i, f).0
+            self.over_length(model, i, f)
         } else {
-            lumped_sum(model, i, f)
+            (lumped_sum(model, i, f), lumped_sum(model, i, |_| 1.0))
         }
     }
 
@@ -519,20 +604,28 @@ impl CrackGrowth {
     /// ([`Self::triaxiality`]) or averaged over `ℓ` (module doc of
     /// [`crate::fracture`], "The compression gate on the tip").
     fn tip_triaxiality(&self, model: &Model, i: usize) -> Real {
-        triaxiality_of(self.tip_reading(model, i, |k| mean_and_von_mises(&model.quad.tau[k])))
+        triaxiality_of(self.tip_reading(model, i, |k| mean_and_von_mises(&model.quad.tau[k])).0)
     }
 
-    /// Whether a crack tip may step into candidate `i` by its stress
-    /// ([`TipGate`]): its triaxiality ([`Self::tip_triaxiality`]) at least
-    /// `tip_min_triaxiality`, or with `tip_gate = "tension"` a tensile
-    /// largest principal value of the Kirchhoff stress read by
-    /// [`Self::tip_reading`] (a positive weighting does not change the
-    /// sign of `σ₁` in a uniform state,
-    /// `the_tension_gate_reads_the_largest_principal_stress`).
-    fn tip_gate_open(&self, model: &Model, i: usize) -> bool {
+    /// The tip's gate at candidate `i` ([`TipGate`]): what it reads and
+    /// whether it opens. Its triaxiality ([`Self::tip_triaxiality`]) at
+    /// least `tip_min_triaxiality`, or with `tip_gate = "tension"` a
+    /// tensile largest principal value of the Kirchhoff stress read by
+    /// [`Self::tip_reading`], reported as the weighted mean, Pa (a
+    /// positive weighting does not change the sign of `σ₁` in a uniform
+    /// state, `the_tension_gate_reads_the_largest_principal_stress`; the
+    /// sign is taken of the sum, before the division).
+    fn tip_gate(&self, model: &Model, i: usize) -> (Real, bool) {
         match self.params.tip_gate {
-            TipGate::Triaxiality => self.tip_triaxiality(model, i) >= self.params.tip_min_triaxiality,
-            TipGate::Tension => largest_principal(&self.tip_reading(model, i, |k| model.quad.tau[k].to_tensor())) > 0.0,
+            TipGate::Triaxiality => {
+                let t = self.tip_triaxiality(model, i);
+                (t, t >= self.params.tip_min_triaxiality)
+            }
+            TipGate::Tension => {
+                let (sum, weight) = self.tip_reading(model, i, |k| model.quad.tau[k].to_tensor());
+                let s1 = largest_principal(&sum);
+                (if weight > 0.0 { s1 / weight } else { 0.0 }, s1 > 0.0)
+            }
         }
     }
 
@@ -673,48 +766,27 @@ impl CrackGrowth {
                 continue;
             };
             self.ensure_grid(model);
-            let d = self.cracks[c].direction();
-            let xt = model.particles.x0[tip];
-            let mean = (xt - self.cracks[c].vertices[0].x0).normalize();
+            let fan = self.fan(model, c);
             let circle = self.circle(model, tip);
-            let dirs: Vec<Vec2> = circle.iter().map(|&j| model.particles.x0[j] - xt).collect();
-            let sector = widest_empty_sector(&dirs);
-            if sector.0 > self.params.fan_angle.to_radians() && sector_contains(sector, &d) {
+            if self.at_surface(model, &fan, &circle) {
                 faces.extend(self.arrest(model, c, time, step)?);
                 continue;
             }
-            let half_fan = 0.5 * self.params.fan_angle.to_radians();
-            let heading = self.heading(model, tip, &d);
             // (rank, criterion value, particle)
             let mut best: Option<(Real, Real, usize)> = None;
             for &j in &circle {
-                if model.particles.flags[j].has(ParticleFlags::CRACK_FACE | ParticleFlags::DETACHED) {
+                let Ok((rank, value)) = self.ranked(model, &fan, j) else {
                     continue;
-                }
-                let r = model.particles.x0[j] - xt;
-                if !in_fans(&r, &d, &mean, half_fan) {
-                    continue;
-                }
-                let value = self.criterion_value(model, j);
-                let rank = self.rank(model, j, value, &r, heading.as_ref());
+                };
                 if value < critical || best.is_some_and(|(bv, _, _)| bv >= rank) {
                     continue;
                 }
-                if !self.tip_gate_open(model, j) {
-                    continue;
+                if self.admits(model, c, &fan, j).1 == CandidateCheck::Eligible {
+                    best = Some((rank, value, j));
                 }
-                if self.passes_over(model, tip, j) || self.blocked_from_tip(model, c, j) {
-                    continue;
-                }
-                if let Some(n) = self.outward_normal(model, j) {
-                    if angle(&r, &n) > MAX_SURFACE_OBLIQUITY.to_radians() {
-                        continue;
-                    }
-                }
-                best = Some((rank, value, j));
             }
             if best.is_none() {
-                if let Some(junction) = self.junction(model, c, critical, &circle, (d, mean)) {
+                if let Some(junction) = self.junction(model, c, critical, &circle, (fan.d, fan.mean)) {
                     faces.extend(self.join(model, c, junction, time, step)?);
                     continue;
                 }
@@ -728,6 +800,108 @@ impl CrackGrowth {
         }
         faces.extend(self.nucleate(model, critical, time, step)?);
         Ok(faces)
+    }
+
+    /// The fan of the growing tip of crack `c`: where it stands, where it
+    /// came from and where it heads ([`Self::heading`]).
+    fn fan(&self, model: &Model, c: usize) -> TipFan {
+        let tip = self.cracks[c].tip.expect("growing");
+        let d = self.cracks[c].direction();
+        let xt = model.particles.x0[tip];
+        TipFan {
+            tip,
+            xt,
+            d,
+            mean: (xt - self.cracks[c].vertices[0].x0).normalize(),
+            half_fan: 0.5 * self.params.fan_angle.to_radians(),
+            heading: self.heading(model, tip, &d),
+        }
+    }
+
+    /// Whether the tip stands on the outer surface facing its own
+    /// direction: its `circle` leaves an empty sector wider than `θ_c`
+    /// that holds the crack's direction (the crack arrests).
+    fn at_surface(&self, model: &Model, fan: &TipFan, circle: &[usize]) -> bool {
+        let dirs: Vec<Vec2> = circle.iter().map(|&j| model.particles.x0[j] - fan.xt).collect();
+        let sector = widest_empty_sector(&dirs);
+        sector.0 > self.params.fan_angle.to_radians() && sector_contains(sector, &fan.d)
+    }
+
+    /// Candidate `j`'s `(rank, criterion value)` for the tip of `fan`
+    /// ([`Self::rank`]), or why it is none: a crack face or detached
+    /// particle, or outside the fan. The first checks of [`Self::grow`].
+    fn ranked(&self, model: &Model, fan: &TipFan, j: usize) -> Result<(Real, Real), CandidateCheck> {
+        if model.particles.flags[j].has(ParticleFlags::CRACK_FACE | ParticleFlags::DETACHED) {
+            return Err(CandidateCheck::Taken);
+        }
+        let r = model.particles.x0[j] - fan.xt;
+        if !in_fans(&r, &fan.d, &fan.mean, fan.half_fan) {
+            return Err(CandidateCheck::OutsideFan);
+        }
+        let value = self.criterion_value(model, j);
+        Ok((self.rank(model, j, value, &r, fan.heading.as_ref()), value))
+    }
+
+    /// The checks of [`Self::grow`] on candidate `j` of crack `c` after
+    /// its criterion: the tip's gate ([`Self::tip_gate`]; its reading is
+    /// returned), a path over another particle, a crack in the way, a
+    /// surface met too obliquely.
+    fn admits(&self, model: &Model, c: usize, fan: &TipFan, j: usize) -> (Real, CandidateCheck) {
+        let (reading, open) = self.tip_gate(model, j);
+        let check = if !open {
+            CandidateCheck::GateClosed
+        } else if self.passes_over(model, fan.tip, j) {
+            CandidateCheck::PassesOver
+        } else if self.blocked_from_tip(model, c, j) {
+            CandidateCheck::Blocked
+        } else if self
+            .outward_normal(model, j)
+            .is_some_and(|n| angle(&(model.particles.x0[j] - fan.xt), &n) > MAX_SURFACE_OBLIQUITY.to_radians())
+        {
+            CandidateCheck::Oblique
+        } else {
+            CandidateCheck::Eligible
+        };
+        (reading, check)
+    }
+
+    /// Every particle within reach of the tip of crack `c` and what
+    /// [`Self::grow`] would make of it now: the diagnosis of a stalled
+    /// tip (`plugsim crack-tips`), and where it heads; no candidates if
+    /// `c` no longer grows. The candidate the tip would step to is the
+    /// [`CandidateCheck::Eligible`] one of largest rank (unless the tip
+    /// stands on the surface, or the crack-speed limit holds it back).
+    pub fn tip_candidates(&mut self, model: &Model, c: usize) -> TipReport {
+        let Some(tip) = self.cracks.get(c).and_then(|k| k.tip) else {
+            return TipReport { heading: None, candidates: Vec::new() };
+        };
+        let critical = self.params.critical_value().unwrap_or(Real::INFINITY);
+        self.ensure_grid(model);
+        let fan = self.fan(model, c);
+        let circle = self.circle(model, tip);
+        let candidates = circle
+            .iter()
+            .map(|&j| {
+                let offset = model.particles.x0[j] - fan.xt;
+                let (rank, value, gate, check) = match self.ranked(model, &fan, j) {
+                    // what the tip would find there, were the fan wider
+                    Err(CandidateCheck::OutsideFan) => (
+                        Real::NAN,
+                        self.criterion_value(model, j),
+                        self.tip_gate(model, j).0,
+                        CandidateCheck::OutsideFan,
+                    ),
+                    Err(check) => (Real::NAN, Real::NAN, Real::NAN, check),
+                    Ok((rank, value)) => {
+                        let (gate, check) = self.admits(model, c, &fan, j);
+                        let check = if value < critical { CandidateCheck::BelowCriterion } else { check };
+                        (rank, value, gate, check)
+                    }
+                };
+                TipCandidate { particle: j, offset, value, rank, gate, check }
+            })
+            .collect();
+        TipReport { heading: fan.heading, candidates }
     }
 
     /// The speed limit's hook ([`super::tip_speed`]): whether the tip of

@@ -542,7 +542,9 @@ pub mod nonlocal;
 pub mod tip_speed;
 pub mod visibility;
 
-pub use growth::{Crack, CrackEvent, CrackGrowth, CrackVertex, EventKind, TipValues};
+pub use growth::{
+    CandidateCheck, Crack, CrackEvent, CrackGrowth, CrackVertex, EventKind, TipCandidate, TipReport, TipValues,
+};
 pub use nonlocal::NonlocalWeight;
 pub use visibility::{CrackSegments, CrackVisibility};
 
