@@ -252,6 +252,10 @@ fn list_cases() -> Result<()> {
 /// checkpoint at `path` (a file, or a run directory's newest), those
 /// outside the fan too with `all`.
 fn crack_tips(path: &Path, set: &[String], all: bool) -> Result<()> {
+    use plugsim::fracture::CandidateCheck;
+    if let Some(key) = set.iter().find(|s| !s.starts_with("fracture.")) {
+        bail!("--set {key}: crack-tips reads the tips again with other fracture.* parameters only");
+    }
     let restored = if path.is_dir() {
         let (r, warnings) = plugsim::checkpoint::read_latest(path)?;
         for w in warnings {
@@ -267,9 +271,6 @@ fn crack_tips(path: &Path, set: &[String], all: bool) -> Result<()> {
         println!("the case grows no cracks");
         return Ok(());
     };
-    if let Some(key) = set.iter().find(|s| !s.starts_with("fracture.")) {
-        bail!("--set {key}: crack-tips reads the tips again with other fracture.* parameters only");
-    }
     if !set.is_empty() {
         let text = toml::to_string(&restored.case).context("writing the checkpoint's case back")?;
         let case = Case::from_str_with(&text, &restored.path.display().to_string(), set)?;
@@ -311,12 +312,12 @@ fn crack_tips(path: &Path, set: &[String], all: bool) -> Result<()> {
         }
         let mut rows = report.candidates;
         rows.sort_by(|a, b| a.rank.is_nan().cmp(&b.rank.is_nan()).then(b.rank.total_cmp(&a.rank)));
-        let chosen = rows.iter().find(|r| r.check == plugsim::fracture::CandidateCheck::Eligible).map(|r| r.particle);
+        let chosen = rows.iter().find(|r| r.check == CandidateCheck::Eligible).map(|r| r.particle);
         println!(
             "  {:>8} {:>9} {:>9} {:>10} {:>9} {:>12}  check",
             "particle", "dX mm", "dY mm", "criterion", "rank", "gate"
         );
-        for r in rows.iter().filter(|r| all || r.check != plugsim::fracture::CandidateCheck::OutsideFan) {
+        for r in rows.iter().filter(|r| all || r.check != CandidateCheck::OutsideFan) {
             println!(
                 "  {:>8} {:>9.4} {:>9.4} {:>10.4} {:>9.4} {:>12.4e}  {}{}",
                 r.particle,

@@ -594,7 +594,7 @@ impl CrackGrowth {
         if self.params.nonlocal_tip_triaxiality {
             self.over_length(model, i, f)
         } else {
-            (lumped_sum(model, i, f), lumped_sum(model, i, |_| 1.0))
+            lumped_sum(model, i, f)
         }
     }
 
@@ -714,7 +714,7 @@ impl CrackGrowth {
     /// lumped projections of the quadrature points' mean and von Mises
     /// stresses (the same weights as [`Self::criterion_value`]).
     pub fn triaxiality(&self, model: &Model, i: usize) -> Real {
-        triaxiality_of(lumped_sum(model, i, |q| mean_and_von_mises(&model.quad.tau[q])))
+        triaxiality_of(lumped_sum(model, i, |q| mean_and_von_mises(&model.quad.tau[q])).0)
     }
 
     /// How far along its locus the material was where the cracks grew:
@@ -1673,22 +1673,26 @@ pub fn live_share(model: &Model, i: usize) -> Real {
     }
 }
 
-/// A stress's mean and von Mises values `(τ_m, τ̄)`, the two sums a
-/// triaxiality is the ratio of.
-/// `Σ_q N_i(X_q) w_q f(q)` over particle `i`'s gather: the lumped
-/// projection's numerator, unnormalised (for ratios and signs).
-fn lumped_sum<T>(model: &Model, i: usize, f: impl Fn(usize) -> T) -> T
+/// `(Σ_q N_i(X_q) w_q f(q), Σ_q N_i(X_q) w_q)` over particle `i`'s
+/// gather: the lumped projection's numerator, unnormalised (the gates
+/// read its ratios and signs), and its weight, as
+/// [`CrackGrowth::over_length`] returns them.
+fn lumped_sum<T>(model: &Model, i: usize, f: impl Fn(usize) -> T) -> (T, Real)
 where
     T: Default + std::ops::AddAssign + std::ops::Mul<Real, Output = T>,
 {
-    let mut sum = T::default();
+    let (mut sum, mut weight) = (T::default(), 0.0);
     for j in model.gather.range(i) {
         let q = model.gather.point[j] as usize;
-        sum += f(q) * (model.gather.value[j] * model.quad.weight[q]);
+        let w = model.gather.value[j] * model.quad.weight[q];
+        sum += f(q) * w;
+        weight += w;
     }
-    sum
+    (sum, weight)
 }
 
+/// A stress's mean and von Mises values `(τ_m, τ̄)`, the two sums a
+/// triaxiality is the ratio of.
 fn mean_and_von_mises(tau: &Block2) -> Vec2 {
     Vec2::new(tau.trace() / 3.0, tau.von_mises())
 }
