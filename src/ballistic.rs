@@ -2144,6 +2144,7 @@ mod tests {
             reference: Vec2::new(9.7e-3, 12e-3),
             mass: 9.326e-6,
             crack_face: true,
+            live_share: Some(0.011),
         };
         let mut fast = shot(180.0, held);
         (fast.fastest, fast.fastest_particle) = (441.2, Some(thrown));
@@ -2155,6 +2156,13 @@ mod tests {
             note.contains("- at 180.00 m/s (2.45 v_i): 441.2 m/s, particle 40608 (a crack-face particle"),
             "{note}"
         );
+        assert!(note.contains("plane strain; 1.1 % of its material left) at (10.01, 10.25) mm"), "{note}");
+        let ghost = crate::step::FastestParticle { live_share: Some(0.0), ..thrown };
+        assert!(ghost.describe().contains("plane strain; none of its material left) at"), "{}", ghost.describe());
+        for whole in [Some(1.0), None] {
+            let whole = crate::step::FastestParticle { live_share: whole, ..thrown };
+            assert!(whole.describe().contains("plane strain) at"), "{}", whole.describe());
+        }
         assert!(!note.contains("190.00"), "{note}");
         // a run taken back from a file without the particle: its speed only
         let mut old = fast.clone();

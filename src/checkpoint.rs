@@ -154,8 +154,9 @@ pub const MAGIC: [u8; 8] = *b"PLUGCKPT";
 /// energy the crack changes moved ([`crate::step::Energies::crack_changes`]),
 /// version 16 the axis as a wall of the contact
 /// ([`crate::contact::ContactSystem::with_axis`]: its switch, last forces
-/// and work).
-pub const FORMAT_VERSION: u32 = 16;
+/// and work), version 17 the fastest particle's live share of material
+/// ([`crate::step::FastestParticle::live_share`]).
+pub const FORMAT_VERSION: u32 = 17;
 /// Subdirectory of a run's output directory that holds its checkpoints.
 pub const DIRECTORY: &str = "checkpoints";
 /// File name extension of a checkpoint.

@@ -42,6 +42,11 @@ fn no_particle_leaves_faster_than_the_rear_face_doubling() {
             let (f, p) = (&sim.fastest, &sim.model.particles);
             assert_eq!((f.reference, f.mass), (p.x0[f.particle], p.mass[f.particle]));
             assert_eq!(f.crack_face, p.flags[f.particle].has(ParticleFlags::CRACK_FACE));
+            // and how much of its material is left (none eroded this early
+            // but near a corner crack; a share, in [0, 1])
+            let share = plugsim::fracture::growth::live_share(&sim.model, f.particle);
+            assert_eq!(f.live_share, Some(share));
+            assert!((0.0..=1.0).contains(&share), "{share}");
             children += usize::from(f.crack_face);
         }
         let v = sim.model.physical(&sim.model.particles.v);
