@@ -1554,9 +1554,9 @@ pub fn report(header: &str, study: &Study) -> String {
     }
     if let Some(most) = largest(&study.shots, |x| x.detached as Real) {
         s.push_str(&format!(
-            "Detached particles (`fracture.detach_below`, not in SPEC §9): erosion left particles without material, \
-             and they left their body's shape functions: at most {} in one run, at {:.2} m/s; each run's summary \
-             names them.\n\n",
+            "Detached particles (`fracture.detach_below`, not in SPEC §9): erosion or a crack split left particles \
+             with little material, and they left their body's shape functions: at most {} in one run, at {:.2} m/s; \
+             each run's summary names them.\n\n",
             most.detached, most.speed
         ));
     }

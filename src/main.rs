@@ -1420,7 +1420,7 @@ fn drive(
         let shown: Vec<String> = s.detached.iter().take(8).map(|(i, t)| format!("{i} at {:.3} us", t * 1e6)).collect();
         let more = if s.detached.len() > 8 { ", ..." } else { "" };
         println!(
-            "  detached: {} particles (erosion left them less than fracture.detach_below of their material; they fly free with their mass): {}{more}",
+            "  detached: {} particles (erosion or a crack split left them less than fracture.detach_below of their material; they fly free with their mass): {}{more}",
             s.detached.len(),
             shown.join(", ")
         );

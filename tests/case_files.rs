@@ -256,33 +256,39 @@ fn a_column_at_the_projectiles_edge_is_checked() {
 /// out (`FractureParameters::for_criterion`): the default model's tip
 /// (the velocity jump, the gate over `ℓ`) under `"nonlocal_damage"`,
 /// SPEC §9's under [RL10]'s criteria, also when `--set` changes the
-/// criterion; a value the case gives is kept.
+/// criterion; a value the case gives is kept. So does `detach_below`: 0.1
+/// under the default model, 0 (never) in the paper's mode.
 #[test]
 fn a_case_without_the_tip_fields_gets_its_criterions() {
-    use plugsim::fracture::{Criterion, TipDirection};
+    use plugsim::fracture::{Criterion, TipDirection, DETACH_BELOW};
     let text = BUILTIN_CASES.iter().find(|(n, _, _)| *n == "borvik-1-axisymmetric-nonlocal").unwrap().1;
-    let sets_tip = |l: &str| l.starts_with("tip_direction") || l.starts_with("nonlocal_tip_triaxiality");
+    let sets_tip = |l: &str| {
+        l.starts_with("tip_direction") || l.starts_with("nonlocal_tip_triaxiality") || l.starts_with("detach_below")
+    };
     assert!(!text.lines().any(sets_tip), "the case relies on the defaults");
     let tip = |sets: &[&str]| {
         let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
         let f = Case::from_str_with(text, "c1.toml", &sets).unwrap().fracture;
-        (f.criterion, f.tip_direction, f.nonlocal_tip_triaxiality)
+        (f.criterion, f.tip_direction, f.nonlocal_tip_triaxiality, f.detach_below)
     };
-    assert_eq!(tip(&[]), (Criterion::NonlocalDamage, TipDirection::VelocityJump, true));
+    assert_eq!(tip(&[]), (Criterion::NonlocalDamage, TipDirection::VelocityJump, true, DETACH_BELOW));
     for (set, c) in [
         ("fracture.criterion=\"damage\"", Criterion::Damage),
         ("fracture.criterion=\"effective_strain\"", Criterion::EffectiveStrain),
     ] {
-        assert_eq!(tip(&[set]), (c, TipDirection::MostDamaged, false), "{set}");
+        assert_eq!(tip(&[set]), (c, TipDirection::MostDamaged, false, 0.0), "{set}");
     }
     let kept = tip(&["fracture.criterion=\"damage\"", "fracture.tip_direction=\"velocity_jump\""]);
-    assert_eq!(kept, (Criterion::Damage, TipDirection::VelocityJump, false));
+    assert_eq!(kept, (Criterion::Damage, TipDirection::VelocityJump, false, 0.0));
     let earlier = tip(&["fracture.tip_direction=\"most_damaged\"", "fracture.nonlocal_tip_triaxiality=false"]);
-    assert_eq!(earlier, (Criterion::NonlocalDamage, TipDirection::MostDamaged, false));
-    // the paper's cases get SPEC §9's tip
+    assert_eq!(earlier, (Criterion::NonlocalDamage, TipDirection::MostDamaged, false, DETACH_BELOW));
+    // the default model without detaching, as before 2026-12-02
+    let never = tip(&["fracture.detach_below=0"]);
+    assert_eq!(never, (Criterion::NonlocalDamage, TipDirection::VelocityJump, true, 0.0));
+    // the paper's cases get SPEC §9's tip and never detach
     let paper = BUILTIN_CASES.iter().find(|(n, _, _)| *n == "borvik-1-plane-strain").unwrap().1;
     let f = Case::from_str_with(paper, "b1.toml", &[]).unwrap().fracture;
-    assert_eq!((f.tip_direction, f.nonlocal_tip_triaxiality), (TipDirection::MostDamaged, false));
+    assert_eq!((f.tip_direction, f.nonlocal_tip_triaxiality, f.detach_below), (TipDirection::MostDamaged, false, 0.0));
     // a bad criterion is still named by the parse
     let e = Case::from_str_with(text, "c1.toml", &["fracture.criterion=\"nosuch\"".into()]).unwrap_err().to_string();
     assert!(e.contains("nosuch"), "{e}");

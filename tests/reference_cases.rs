@@ -116,6 +116,7 @@ fn every_member_uses_the_same_numerical_parameters() {
             criterion: own.criterion,
             tip_direction: own.tip_direction,
             nonlocal_tip_triaxiality: own.nonlocal_tip_triaxiality,
+            detach_below: own.detach_below,
             ..reference.fracture
         };
         assert_eq!(case.fracture, expected, "{name}: fracture");

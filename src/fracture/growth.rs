@@ -427,6 +427,15 @@ pub struct CrackGrowth {
     /// [`CrackGrowth::detach_isolated`]: those eroded since are the new
     /// ones whose particles it looks at.
     eroded_seen: Vec<bool>,
+    /// The particles whose gather a local rebuild (a split's, a
+    /// detachment's) changed since [`CrackGrowth::detach_isolated`] last
+    /// looked: a split can leave a crack-face particle's share of live
+    /// material under `detach_below` with no point newly eroded (its rows
+    /// lose the live points across the crack). Drained by every call,
+    /// which runs in the same step as the changes, so empty between steps
+    /// and not in checkpoints.
+    #[serde(skip)]
+    gather_changed: Vec<usize>,
     /// The particles detached so far and when, s, in order.
     pub detached: Vec<(usize, Real)>,
 }
@@ -498,6 +507,7 @@ impl CrackGrowth {
             last_time: None,
             nonlocal: OnceLock::new(),
             eroded_seen: Vec::new(),
+            gather_changed: Vec::new(),
             detached: Vec::new(),
         }
     }
@@ -1421,24 +1431,43 @@ impl CrackGrowth {
     }
 
     /// Detach the particles that erosion has left without material
-    /// (`detach_below`; module doc, "Detached particles"): after points
-    /// were eroded, each particle in their rows whose share of its
-    /// material at points not eroded, `Σ_live |N_I| ρ w / Σ |N_I| ρ w`, is
-    /// below `detach_below` is flagged [`ParticleFlags::DETACHED`] and the
-    /// rows around it are rebuilt without it (`Self::rebuild_local`: the
-    /// deformation gradients carried over, the masses re-lumped with its
-    /// own kept, the momentum restored). A point whose particles are then
-    /// all detached is eroded, and the rebuild empties its row. The
-    /// particles detached at `time` (s), in index order.
+    /// (`detach_below`; module doc, "Detached particles"): each particle
+    /// whose share of its material at points not eroded,
+    /// `Σ_live |N_I| ρ w / Σ |N_I| ρ w`, is below `detach_below` is
+    /// flagged [`ParticleFlags::DETACHED`] and the rows around it are
+    /// rebuilt without it (`Self::rebuild_local`: the deformation
+    /// gradients carried over, the masses re-lumped with its own kept, the
+    /// momentum restored). A point whose particles are then all detached
+    /// is eroded, and the rebuild empties its row. The share can fall in
+    /// two ways, and both are looked at: points of the particle's gather
+    /// eroded since the last call, or a rebuild (a split's, or a
+    /// detachment's in this call) that changed its gather. The particles
+    /// detached at `time` (s), in the order found (index order in each
+    /// round).
     pub fn detach_isolated(&mut self, model: &mut Model, time: Real) -> Result<Vec<usize>, FractureError> {
         let threshold = self.params.detach_below;
         if threshold <= 0.0 {
+            self.gather_changed.clear();
             return Ok(Vec::new());
         }
+        let mut all = Vec::new();
+        loop {
+            let isolated = self.detach_round(model, time, threshold)?;
+            if isolated.is_empty() {
+                return Ok(all);
+            }
+            all.extend(isolated);
+        }
+    }
+
+    /// One round of [`Self::detach_isolated`]: the particles whose share
+    /// fell under `threshold` since the last round, detached.
+    fn detach_round(&mut self, model: &mut Model, time: Real, threshold: Real) -> Result<Vec<usize>, FractureError> {
         let eroded = &model.quad.eroded;
         self.eroded_seen.resize(eroded.len(), false);
-        // The particles in the rows of the points eroded since the last call.
-        let mut near = std::collections::BTreeSet::new();
+        // The particles in the rows of the points eroded since the last
+        // call, and those whose gather a rebuild changed.
+        let mut near: std::collections::BTreeSet<usize> = self.gather_changed.drain(..).collect();
         for (q, (&e, seen)) in eroded.iter().zip(self.eroded_seen.iter_mut()).enumerate() {
             if e && !*seen {
                 *seen = true;
@@ -1575,6 +1604,7 @@ impl CrackGrowth {
         model.gather.patch_into(&spare.qp_shape.offsets, &model.qp_shape, &rows_q, &touched, n, &mut spare.gather);
         std::mem::swap(&mut model.gather, &mut spare.gather);
         let touched: Vec<usize> = (0..n).filter(|&i| touched[i]).collect();
+        self.gather_changed.extend_from_slice(&touched);
         // Re-lumped: the material's mass; the mass scaling added
         // ([`crate::stability`]) stays on its particle.
         let before: Real = touched.iter().map(|&i| model.particles.mass[i] - model.particles.added_mass[i]).sum();
