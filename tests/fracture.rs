@@ -1611,8 +1611,10 @@ fn a_split_that_cuts_a_particle_off_its_live_material_detaches_it() {
         let detached = g.detach_isolated(&mut m, t).unwrap();
         attached_above(&m, &format!("step {step}"));
         splits += g.events.len() - events;
-        let eroded_after_growth = m.quad.eroded.iter().filter(|&&e| e).count();
-        if !detached.is_empty() && eroded_after_growth == eroded {
+        // Counted after the growth and the detaching (which erodes a point
+        // whose particles all left): a stage that eroded nothing.
+        let eroded_after = m.quad.eroded.iter().filter(|&&e| e).count();
+        if !detached.is_empty() && eroded_after == eroded {
             by_splits.extend(detached);
         }
     }

@@ -1439,9 +1439,10 @@ impl CrackGrowth {
     /// gradients carried over, the masses re-lumped with its own kept, the
     /// momentum restored). A point whose particles are then all detached
     /// is eroded, and the rebuild empties its row. The share can fall in
-    /// two ways, and both are looked at: points of the particle's gather
-    /// eroded since the last call, or a rebuild (a split's, or a
-    /// detachment's in this call) that changed its gather. The particles
+    /// three ways, and each is looked at: points of the particle's gather
+    /// eroded since the last call, a split's rebuild that changed its
+    /// gather, or a detachment's in this call (so the rounds repeat until
+    /// one detaches nothing). The particles
     /// detached at `time` (s), in the order found (index order in each
     /// round).
     pub fn detach_isolated(&mut self, model: &mut Model, time: Real) -> Result<Vec<usize>, FractureError> {

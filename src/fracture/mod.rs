@@ -230,8 +230,8 @@
 //!   118 µs (`docs/validation.md`).
 //! - **Detached particles** (`detach_below`; the default model's default
 //!   since 2026-12-02, 0.1 ([`DETACH_BELOW`]); 0, never, with \[RL10\]'s
-//!   criteria, the paper's mode; not in SPEC §9 or \[RL10\]). Erosion removes a point's stress but not the particles in
-//!   its row. A particle whose own material is nearly all eroded (a torn
+//!   criteria, the paper's mode; not in SPEC §9 or \[RL10\]). Erosion
+//!   removes a point's stress but not the particles in its row. A particle whose own material is nearly all eroded (a torn
 //!   lip, the sliver beside the projectile's edge) is then held by the
 //!   few live points at the tail of its support, where its shape function
 //!   is small but its gradient is not: their stress pushes it with the
@@ -276,10 +276,14 @@
 //!   is (610 m/s, 80 mm from the plate). Detaching takes such a particle
 //!   out of every row, so neither reaches it. Measured on the default
 //!   model's ladders ("Detaching made the default model's", same file):
-//!   the blunt plates' outcomes, limits and residuals are unchanged to the
-//!   digit; the throws past `2 v_i` of the 72-row runs are gone; the
-//!   hemispherical nose's residual, which changes its plug with the rung,
-//!   moves. *In 3D* the share is the same sum over a particle's support
+//!   the blunt plates' outcomes, limits and residuals at 12 and 24 rows,
+//!   and Case I's residual at 48 rows, are unchanged to the digit (at 72
+//!   and 96 rows it moves by +0.54 and +0.04 m/s); Case I's plate's
+//!   48-row limit falls from 180.25 ± 0.75 to 176.50 ± 1.50 m/s (not
+//!   traced); the throws past `2 v_i` of the rerun blunt runs are gone
+//!   but for one particle squeezed out with 38 % of its material at
+//!   2.02 `v_i`; the hemispherical nose loses its 1.9 km/s throw, and its
+//!   residual, which changes its plug with the rung, moves. *In 3D* the share is the same sum over a particle's support
 //!   (the free node of an eroded element in a 3D element code).
 //! - **The default model: Johnson–Cook damage over a material length
 //!   (issue #19; `criterion = "nonlocal_damage"`, the default; \[RL10\]'s
