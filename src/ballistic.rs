@@ -584,9 +584,14 @@ pub struct Shot {
     /// [`crate::run::RunSummary::axis_energy`]).
     #[serde(default)]
     pub axis_energy: Real,
-    /// Particles detached from their body (0 without it, `fracture.detach_below`).
+    /// How many particles were detached from their body (0 without it,
+    /// `fracture.detach_below`).
     #[serde(default)]
     pub detached: usize,
+    /// Which, when and from where, in the order detached (empty in a
+    /// record written before they were kept, which has the count alone).
+    #[serde(default)]
+    pub detached_particles: Vec<crate::run::DetachedParticle>,
     /// The fastest particle: which, where from, its mass, when and whether
     /// it lay on a crack face (`None` in a run finished by a build that did
     /// not record it).
@@ -1089,6 +1094,7 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
                 floor_eroded: s.floor_eroded.unwrap_or(0),
                 axis_energy: s.axis_energy,
                 detached: s.detached.len(),
+                detached_particles: s.detached,
                 fastest_particle: Some(s.fastest),
             };
             let kept = FinishedRun { writer: crate::checkpoint::this_writer(), shot: shot.clone() };
@@ -1556,7 +1562,7 @@ pub fn report(header: &str, study: &Study) -> String {
         s.push_str(&format!(
             "Detached particles (`fracture.detach_below`, not in SPEC §9): erosion or a crack split left particles \
              with little material, and they left their body's shape functions: at most {} in one run, at {:.2} m/s; \
-             each run's summary names them.\n\n",
+             each run's summary and its `{SHOT_FILE}` name them.\n\n",
             most.detached, most.speed
         ));
     }
@@ -2125,6 +2131,7 @@ mod tests {
             floor_eroded: 0,
             axis_energy: 0.0,
             detached: 0,
+            detached_particles: vec![],
             fastest_particle: None,
             dir: PathBuf::new(),
         }
@@ -2397,6 +2404,15 @@ mod tests {
         shots[1].floor_eroded = 3;
         shots[2].floor_eroded = 12;
         shots[0].detached = 2;
+        shots[0].detached_particles = [(23040, 48.3e-6, true), (3317, 51.0e-6, false)]
+            .map(|(particle, time, crack_face)| crate::run::DetachedParticle {
+                particle,
+                time,
+                reference: Vec2::new(9.917e-3, 11.1e-3),
+                mass: 6.9e-6,
+                crack_face,
+            })
+            .to_vec();
         shots[2].axis_energy = 3.7;
         let text = report("header", &study(&shots));
         assert!(
@@ -2404,9 +2420,24 @@ mod tests {
             "{text}"
         );
         assert!(
-            text.contains("`fracture.detach_below`") && text.contains("at most 2 in one run, at 150.00 m/s"),
+            text.contains("`fracture.detach_below`")
+                && text.contains("at most 2 in one run, at 150.00 m/s")
+                && text.contains("its `shot.toml` name them"),
             "{text}"
         );
+        assert_eq!(
+            shots[0].detached_particles[0].describe(),
+            "23040 at 48.300 us (a crack-face particle from (9.917, 11.100) mm, 6.900e-6 kg)"
+        );
+        // The shot file keeps which particles left, and one written with
+        // their count alone still reads.
+        let kept = FinishedRun { writer: "w".into(), shot: shots[0].clone() };
+        let file = toml::to_string(&kept).unwrap();
+        assert_eq!(toml::from_str::<FinishedRun>(&file).unwrap().shot, shots[0]);
+        let mut older: toml::Table = toml::from_str(&file).unwrap();
+        older["shot"].as_table_mut().unwrap().remove("detached_particles").unwrap();
+        let back: FinishedRun = toml::from_str(&toml::to_string(&older).unwrap()).unwrap();
+        assert_eq!((back.shot.detached, back.shot.detached_particles.len()), (2, 0));
         assert!(text.contains("at most 7.0000e-5 kg") && text.contains("in the run at 170.00 m/s"), "{text}");
         assert!(
             text.contains("`time.erode_failed_below`") && text.contains("at most 12 in one run, at 190.00 m/s"),

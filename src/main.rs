@@ -1417,7 +1417,7 @@ fn drive(
         );
     }
     if !s.detached.is_empty() {
-        let shown: Vec<String> = s.detached.iter().take(8).map(|(i, t)| format!("{i} at {:.3} us", t * 1e6)).collect();
+        let shown: Vec<String> = s.detached.iter().take(8).map(|d| d.describe()).collect();
         let more = if s.detached.len() > 8 { ", ..." } else { "" };
         println!(
             "  detached: {} particles (erosion or a crack split left them less than fracture.detach_below of their material; they fly free with their mass): {}{more}",

@@ -5,7 +5,7 @@ use crate::case::Case;
 use crate::checkpoint::{CheckpointError, RunProgress};
 use crate::contact::{ContactSystem, DeformableMasters, DeformableSwitches, SlaveSet, SurfaceDetection};
 use crate::io::IoError;
-use crate::math::Real;
+use crate::math::{Real, Vec2};
 use crate::memory::{Footprint, MemoryError};
 use crate::model::{Model, ModelError};
 use crate::output::OutputWriter;
@@ -68,6 +68,57 @@ impl RunConfig {
 /// typo (a `fixed_dt` of 1e-15 s, an end time of 1 s for a 30 µs impact),
 /// and the run would not finish in any useful time.
 pub const MAX_STEPS: Real = 1e9;
+
+/// A particle detached from its body (`fracture.detach_below`,
+/// [`crate::fracture::CrackGrowth::detach_isolated`]): which, when, and
+/// where its material came from, so that a study can say which particles
+/// left and a run can be traced from them (docs/validation.md, "Detaching
+/// made the default model's").
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct DetachedParticle {
+    pub particle: usize,
+    /// When, s.
+    pub time: Real,
+    /// Its reference position `X_I`, m.
+    pub reference: Vec2,
+    /// Its lumped mass, kg (kg/m in plane strain): a detached particle
+    /// keeps the mass it had when it left.
+    pub mass: Real,
+    /// Whether it lay on a crack face (a split's child or parent).
+    pub crack_face: bool,
+}
+
+impl DetachedParticle {
+    /// The records of `detached` ((particle, time) in the order detached,
+    /// [`crate::fracture::CrackGrowth::detached`]) in `model`.
+    pub fn of(model: &Model, detached: &[(usize, Real)]) -> Vec<DetachedParticle> {
+        let p = &model.particles;
+        detached
+            .iter()
+            .map(|&(i, time)| DetachedParticle {
+                particle: i,
+                time,
+                reference: p.x0[i],
+                mass: p.mass[i],
+                crack_face: p.flags[i].has(crate::particles::ParticleFlags::CRACK_FACE),
+            })
+            .collect()
+    }
+
+    /// For a run summary: "23040 at 48.312 us (a crack-face particle from
+    /// (9.917, 11.100) mm, 6.914e-6 kg)".
+    pub fn describe(&self) -> String {
+        format!(
+            "{} at {:.3} us ({} from ({:.3}, {:.3}) mm, {:.3e} kg)",
+            self.particle,
+            self.time * 1e6,
+            if self.crack_face { "a crack-face particle" } else { "a particle" },
+            self.reference.x * 1e3,
+            self.reference.y * 1e3,
+            self.mass
+        )
+    }
+}
 
 /// What a finished run reports.
 #[derive(Clone, Debug)]
@@ -134,11 +185,11 @@ pub struct RunSummary {
     /// (`[time] erode_failed_below`, [`crate::stability::StableStep::eroded`]);
     /// `None` without it.
     pub floor_eroded: Option<u64>,
-    /// Particles that erosion left without material and that were detached
-    /// from their body (`fracture.detach_below`,
-    /// [`crate::fracture::CrackGrowth::detach_isolated`]) and when, s, in
-    /// order.
-    pub detached: Vec<(usize, Real)>,
+    /// Particles that erosion or a crack split left with less than
+    /// `fracture.detach_below` of their material and that were detached
+    /// from their body ([`crate::fracture::CrackGrowth::detach_isolated`]),
+    /// in the order detached.
+    pub detached: Vec<DetachedParticle>,
     /// The radial kinetic energy the axis took from particles that reached
     /// it, J (`−`[`crate::contact::ContactSystem::axis_work`]; 0 where none
     /// did, or without a contact stage).
@@ -568,7 +619,7 @@ fn time_loop(
         plug,
         eroded_points: sim.model.quad.eroded.iter().filter(|&&e| e).count(),
         floor_eroded: sim.floors.erosion.and(sim.stable.as_ref()).map(|s| s.eroded),
-        detached: sim.cracks.as_ref().map_or_else(Vec::new, |c| c.detached.clone()),
+        detached: sim.cracks.as_ref().map_or_else(Vec::new, |c| DetachedParticle::of(&sim.model, &c.detached)),
         exposed: crate::output::exposed_contact_summary(&history),
         axis_energy: sim.contact.as_ref().map_or(0.0, |c| -c.axis_work()),
         cracks,

@@ -279,8 +279,10 @@
 //!   the blunt plates' outcomes, limits and residuals at 12 and 24 rows,
 //!   and Case I's residual at 48 rows, are unchanged to the digit (at 72
 //!   and 96 rows it moves by +0.54 and +0.04 m/s); Case I's plate's
-//!   48-row limit falls from 180.25 ± 0.75 to 176.50 ± 1.50 m/s (not
-//!   traced); the throws past `2 v_i` of the rerun blunt runs are gone
+//!   48-row limit falls from 180.25 ± 0.75 to 176.50 ± 1.50 m/s (traced
+//!   at 178 m/s: detaching the rim crack's crushed mouth puts its tip on
+//!   the next column outward, which cuts the plug in time; "What
+//!   detaching moved on Case I's 48-row plate"); the throws past `2 v_i` of the rerun blunt runs are gone
 //!   but for one particle squeezed out with 38 % of its material at
 //!   2.02 `v_i`; the hemispherical nose loses its 1.9 km/s throw, and its
 //!   residual, which changes its plug with the rung, moves. *In 3D* the share is the same sum over a particle's support
