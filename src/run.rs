@@ -109,12 +109,10 @@ impl DetachedParticle {
     /// (9.917, 11.100) mm, 6.914e-6 kg)".
     pub fn describe(&self) -> String {
         format!(
-            "{} at {:.3} us ({} from ({:.3}, {:.3}) mm, {:.3e} kg)",
+            "{} at {:.3} us ({}, {:.3e} kg)",
             self.particle,
             self.time * 1e6,
-            if self.crack_face { "a crack-face particle" } else { "a particle" },
-            self.reference.x * 1e3,
-            self.reference.y * 1e3,
+            crate::step::particle_origin(self.crack_face, self.reference),
             self.mass
         )
     }

@@ -224,18 +224,24 @@ impl FastestParticle {
             _ => String::new(),
         };
         format!(
-            "{:.1} m/s, particle {} ({} from ({:.3}, {:.3}) mm, mass {:.3e} kg; kg/m in plane strain{left}) at ({:.2}, {:.2}) mm, t = {:.3} us",
+            "{:.1} m/s, particle {} ({}, mass {:.3e} kg; kg/m in plane strain{left}) at ({:.2}, {:.2}) mm, t = {:.3} us",
             self.speed,
             self.particle,
-            if self.crack_face { "a crack-face particle" } else { "a particle" },
-            self.reference.x * 1e3,
-            self.reference.y * 1e3,
+            particle_origin(self.crack_face, self.reference),
             self.mass,
             self.position.x * 1e3,
             self.position.y * 1e3,
             self.time * 1e6
         )
     }
+}
+
+/// What a report says of a particle's kind and origin: "a crack-face
+/// particle from (9.877, 10.200) mm" (its reference position `X_I`), or
+/// "a particle from …" off the cracks.
+pub fn particle_origin(crack_face: bool, reference: Vec2) -> String {
+    let kind = if crack_face { "a crack-face particle" } else { "a particle" };
+    format!("{kind} from ({:.3}, {:.3}) mm", reference.x * 1e3, reference.y * 1e3)
 }
 
 /// `(sqrt(max_I s2(I)), I)` over `n` particles, for a squared speed `s2`:

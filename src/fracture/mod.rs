@@ -231,9 +231,10 @@
 //! - **Detached particles** (`detach_below`; the default model's default
 //!   since 2026-12-02, 0.1 ([`DETACH_BELOW`]); 0, never, with \[RL10\]'s
 //!   criteria, the paper's mode; not in SPEC §9 or \[RL10\]). Erosion
-//!   removes a point's stress but not the particles in its row. A particle whose own material is nearly all eroded (a torn
-//!   lip, the sliver beside the projectile's edge) is then held by the
-//!   few live points at the tail of its support, where its shape function
+//!   removes a point's stress but not the particles in its row. A
+//!   particle whose own material is nearly all eroded (a torn lip, the
+//!   sliver beside the projectile's edge) is then held by the few live
+//!   points at the tail of its support, where its shape function
 //!   is small but its gradient is not: their stress pushes it with the
 //!   full gradient while it barely moves them, and nothing holds it back.
 //!   In Case II's plate at 96 rows and 115 m/s such a crack-face particle,
@@ -282,11 +283,12 @@
 //!   48-row limit falls from 180.25 ± 0.75 to 176.50 ± 1.50 m/s (traced
 //!   at 178 m/s: detaching the rim crack's crushed mouth puts its tip on
 //!   the next column outward, which cuts the plug in time; "What
-//!   detaching moved on Case I's 48-row plate"); the throws past `2 v_i` of the rerun blunt runs are gone
-//!   but for one particle squeezed out with 38 % of its material at
-//!   2.02 `v_i`; the hemispherical nose loses its 1.9 km/s throw, and its
-//!   residual, which changes its plug with the rung, moves. *In 3D* the share is the same sum over a particle's support
-//!   (the free node of an eroded element in a 3D element code).
+//!   detaching moved on Case I's 48-row plate"); the throws past `2 v_i`
+//!   of the rerun blunt runs are gone but for one particle squeezed out
+//!   with 38 % of its material at 2.02 `v_i`; the hemispherical nose loses
+//!   its 1.9 km/s throw, and its residual, which changes its plug with the
+//!   rung, moves. *In 3D* the share is the same sum over a particle's
+//!   support (the free node of an eroded element in a 3D element code).
 //! - **The default model: Johnson–Cook damage over a material length
 //!   (issue #19; `criterion = "nonlocal_damage"`, the default; \[RL10\]'s
 //!   `"effective_strain"` and `"damage"` stay as they were, the paper's
