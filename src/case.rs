@@ -483,6 +483,11 @@ pub struct OutputSpec {
     /// perforation times.
     #[serde(default)]
     pub plot_times: Vec<Real>,
+    /// Particles (indices as generated, `0..n`) whose forces are written
+    /// at every step to `trace.csv` ([`crate::output::ParticleTrace`]): to
+    /// find what accelerates a particle. Default: none (no file).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub trace_particles: Vec<usize>,
 }
 
 fn ten() -> u64 {
@@ -554,7 +559,14 @@ fn all_fields() -> Vec<String> {
 
 impl Default for OutputSpec {
     fn default() -> Self {
-        OutputSpec { interval: None, directory: None, fields: all_fields(), history_every: 10, plot_times: Vec::new() }
+        OutputSpec {
+            interval: None,
+            directory: None,
+            fields: all_fields(),
+            history_every: 10,
+            plot_times: Vec::new(),
+            trace_particles: Vec::new(),
+        }
     }
 }
 
@@ -855,6 +867,11 @@ impl Case {
         for (j, &t) in self.output.plot_times.iter().enumerate() {
             if !(t.is_finite() && t >= 0.0) {
                 add(format!("output.plot_times[{j}]"), format!("must be a time >= 0 s, got {t}"));
+            }
+        }
+        for (j, &i) in self.output.trace_particles.iter().enumerate() {
+            if self.output.trace_particles[..j].contains(&i) {
+                add(format!("output.trace_particles[{j}]"), format!("particle {i} is listed twice"));
             }
         }
         for (j, f) in self.output.fields.iter().enumerate() {

@@ -510,6 +510,149 @@ impl OutputWriter {
     }
 }
 
+/// Columns of `trace.csv` ([`ParticleTrace`]).
+pub const TRACE_COLUMNS: &[&str] = &[
+    "time",
+    "step",
+    "particle",
+    "x",
+    "y",
+    "vx",
+    "vy",
+    "coefficient_vx",
+    "coefficient_vy",
+    "ax",
+    "ay",
+    "f_int_x",
+    "f_int_y",
+    "f_contact_x",
+    "f_contact_y",
+    "f_ext_x",
+    "f_ext_y",
+    "mass",
+    "live_share",
+    "flags",
+];
+
+/// `trace.csv`: the forces on chosen particles at every step
+/// (`output.trace_particles`), to find what accelerates a particle (a
+/// particle thrown off, one squeezed out of a crack's mouth) step by step.
+///
+/// One row per traced particle and step, written after the step: the time
+/// and step reached; the particle's physical position `x = X_I + u(X_I)`
+/// and velocity `v(X_I) = Σ_J N_J(X_I) V_J` after it (SPEC §2: RK particles
+/// are not interpolating; the snapshots' positions and the fastest
+/// particle's speed are these); its own coefficient `V_I^{n+½}`, the one
+/// the step integrates; and the acceleration the step applied to that
+/// coefficient with its three terms, `m a = f_ext + f_contact − f_int`
+/// ([`Simulation::step`], a held component's acceleration being zero),
+/// so that `V^{n+½} − V^{n−½} = ½ (Δt_{n−½} + Δt_{n+½}) a`: `f_int` is the internal force the
+/// step integrated (formed at the end of the step before, after any crack
+/// change, so it is read before the step), `f_contact` the contact force of
+/// the step (the rigid bodies', the deformable bodies' and the axis's, on
+/// the particle as a slave and as a neighbour a slave's force is spread
+/// to). Then its mass, its live share of material
+/// ([`crate::fracture::live_share`]) and its flags
+/// ([`crate::particles::ParticleFlags`]) after the step.
+pub struct ParticleTrace {
+    /// The particles traced, in the case's order.
+    particles: Vec<usize>,
+    /// `trace.csv`; `None` when no particle is traced.
+    writer: Option<HistoryWriter>,
+    /// Each traced particle's internal force before the step.
+    f_int: Vec<Vec2>,
+}
+
+impl ParticleTrace {
+    /// Start `dir/trace.csv` for `particles` (no file without any).
+    pub fn create(dir: &Path, particles: &[usize]) -> Result<Self, IoError> {
+        let writer = match particles.is_empty() {
+            true => None,
+            false => Some(HistoryWriter::create(&dir.join("trace.csv"), TRACE_COLUMNS)?),
+        };
+        Ok(Self::writing(particles, writer))
+    }
+
+    fn writing(particles: &[usize], writer: Option<HistoryWriter>) -> Self {
+        ParticleTrace { particles: particles.to_vec(), writer, f_int: vec![Vec2::zeros(); particles.len()] }
+    }
+
+    /// Continue `dir/trace.csv` of a run resumed at step `step`: the rows
+    /// of the steps after it are dropped (the resumed run writes them
+    /// again); a missing file is started anew.
+    pub fn resume(dir: &Path, particles: &[usize], step: u64) -> Result<Self, IoError> {
+        let path = dir.join("trace.csv");
+        if particles.is_empty() || !path.exists() {
+            return Self::create(dir, particles);
+        }
+        let text = std::fs::read_to_string(&path).map_err(|source| IoError::Read { path: path.clone(), source })?;
+        // The header, then the rows up to the first of a later step.
+        let mut keep = 0;
+        for (k, line) in text.split_inclusive('\n').enumerate() {
+            let row_step = line.split(',').nth(1).and_then(|f| f.trim().parse::<f64>().ok());
+            let later = k > 0 && row_step.is_none_or(|s| s > step as f64);
+            if later || !line.ends_with('\n') {
+                break;
+            }
+            keep += line.len() as u64;
+        }
+        let writer = HistoryWriter::continue_at(&path, TRACE_COLUMNS, keep)?;
+        Ok(Self::writing(particles, Some(writer)))
+    }
+
+    /// Before a step: keep the internal force the step will integrate.
+    pub fn before_step(&mut self, sim: &Simulation) {
+        if self.writer.is_some() {
+            for (f, &i) in self.f_int.iter_mut().zip(&self.particles) {
+                *f = sim.model.particles.f_int[i];
+            }
+        }
+    }
+
+    /// After a step: one row per traced particle.
+    pub fn after_step(&mut self, sim: &Simulation) -> Result<(), IoError> {
+        let Some(writer) = self.writer.as_mut() else {
+            return Ok(());
+        };
+        let p = &sim.model.particles;
+        for (&i, fi) in self.particles.iter().zip(&self.f_int) {
+            let shape = &sim.model.particle_shape;
+            let (x, v) = (p.x0[i] + shape.interpolate(i, &p.u), shape.interpolate(i, &p.v));
+            let (coefficient, a, fe) = (p.v[i], p.a[i], p.f_ext[i]);
+            let fc = sim.f_contact.get(i).copied().unwrap_or_else(Vec2::zeros);
+            let share = crate::fracture::growth::live_share(&sim.model, i);
+            writer.write_row(&[
+                sim.time,
+                sim.step as Real,
+                i as Real,
+                x.x,
+                x.y,
+                v.x,
+                v.y,
+                coefficient.x,
+                coefficient.y,
+                a.x,
+                a.y,
+                fi.x,
+                fi.y,
+                fc.x,
+                fc.y,
+                fe.x,
+                fe.y,
+                p.mass[i],
+                share,
+                p.flags[i].0 as Real,
+            ])?;
+        }
+        Ok(())
+    }
+
+    /// `fsync` the rows written so far (at a checkpoint).
+    pub fn sync(&self) -> Result<(), IoError> {
+        self.writer.as_ref().map_or(Ok(()), HistoryWriter::sync)
+    }
+}
+
 /// The rigid bodies' release trackers after the rows of `table` (a resumed
 /// run continues them; the live ones see every step, these every history row).
 fn replay_releases(table: &crate::io::HistoryTable, rigid: &[(String, Vec2)]) -> Vec<crate::residual::ReleaseTracker> {

@@ -8,7 +8,7 @@ use crate::io::IoError;
 use crate::math::{Real, Vec2};
 use crate::memory::{Footprint, MemoryError};
 use crate::model::{Model, ModelError};
-use crate::output::OutputWriter;
+use crate::output::{OutputWriter, ParticleTrace};
 use crate::step::{Simulation, SolverError};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -225,6 +225,8 @@ pub enum RunError {
     Unstable { error: SolverError, last_snapshot: PathBuf, dir: PathBuf },
     #[error(transparent)]
     Memory(#[from] MemoryError),
+    #[error("output.trace_particles[{entry}]: particle {particle} does not exist (the model has {count} particles, 0 to {})", count.saturating_sub(1))]
+    TracedParticle { entry: usize, particle: usize, count: usize },
     #[error("time step {dt:e} s: {message}")]
     TimeStep { dt: Real, message: String },
     #[error(transparent)]
@@ -310,6 +312,14 @@ fn build_simulation_without_cracks(case: &Case) -> Result<Simulation, RunError> 
     Ok(sim)
 }
 
+/// Every particle of `output.trace_particles` must exist (`0..count`).
+fn check_traced_particles(traced: &[usize], count: usize) -> Result<(), RunError> {
+    match traced.iter().enumerate().find(|&(_, &i)| i >= count) {
+        Some((j, &particle)) => Err(RunError::TracedParticle { entry: j, particle, count }),
+        None => Ok(()),
+    }
+}
+
 /// The step must be a positive number and the run must end in at most
 /// [`MAX_STEPS`] steps.
 fn check_time_step(sim: &Simulation, end: Real) -> Result<(), RunError> {
@@ -353,6 +363,7 @@ pub fn execute(case: &Case, cfg: &RunConfig, progress: &mut dyn FnMut(Progress))
     let t_setup = Instant::now();
     // Build before touching the disk: a case that cannot be discretized leaves nothing behind.
     let sim = build_simulation(&case)?;
+    check_traced_particles(&case.output.trace_particles, sim.model.particles.len())?;
     prepare_output_dir(&cfg.out_dir, cfg.force)?;
     // A reused directory must not keep another run's checkpoints for `resume` to find.
     crate::checkpoint::remove_all(&crate::checkpoint::directory(&cfg.out_dir))?;
@@ -363,12 +374,13 @@ pub fn execute(case: &Case, cfg: &RunConfig, progress: &mut dyn FnMut(Progress))
     write("case.resolved.toml", case.resolved_toml())?;
     write("run_info.toml", toml::to_string_pretty(&cfg.info).unwrap_or_default())?;
     let out = OutputWriter::create(&cfg.out_dir, &case.output.fields, &case.flights())?;
+    let trace = ParticleTrace::create(&cfg.out_dir, &case.output.trace_particles)?;
     let schedule = Schedule {
         next_snapshot: 0.0,
         next_checkpoint: case.checkpoint.interval.unwrap_or(Real::INFINITY),
         max_drift: 0.0,
     };
-    time_loop(&case, sim, out, schedule, false, cfg, t_setup, progress)
+    time_loop(&case, sim, (out, trace), schedule, false, cfg, t_setup, progress)
 }
 
 /// Continue the run in `cfg.out_dir` from its newest readable checkpoint to
@@ -395,6 +407,7 @@ pub fn resume(cfg: &RunConfig, progress: &mut dyn FnMut(Progress)) -> Result<Run
         saved.history_bytes,
         sim.cracks.as_ref(),
     )?;
+    let trace = ParticleTrace::resume(&cfg.out_dir, &case.output.trace_particles, sim.step)?;
     append_resume_record(cfg, &path, sim.step)?;
     progress(Progress::Resumed { sim: &sim, checkpoint: &path, warnings: &warnings });
     let schedule = Schedule {
@@ -402,7 +415,7 @@ pub fn resume(cfg: &RunConfig, progress: &mut dyn FnMut(Progress)) -> Result<Run
         next_checkpoint: saved.next_checkpoint,
         max_drift: saved.max_drift,
     };
-    time_loop(&case, sim, out, schedule, true, cfg, t_setup, progress)
+    time_loop(&case, sim, (out, trace), schedule, true, cfg, t_setup, progress)
 }
 
 /// Add a `[[resumed]]` record (provenance of the continuing process) to
@@ -469,7 +482,7 @@ fn save_checkpoint(
 fn time_loop(
     case: &Case,
     mut sim: Simulation,
-    mut out: OutputWriter,
+    (mut out, mut trace): (OutputWriter, ParticleTrace),
     mut schedule: Schedule,
     mut outputs_done: bool,
     cfg: &RunConfig,
@@ -532,6 +545,7 @@ fn time_loop(
                 }
             }
             let t = Instant::now();
+            trace.sync()?;
             let path = save_checkpoint(case, &sim, &mut out, &schedule, &cfg.out_dir)?;
             output_wall += t.elapsed();
             last_checkpoint = Instant::now();
@@ -545,7 +559,9 @@ fn time_loop(
                 });
             }
         }
+        trace.before_step(&sim);
         let stepped = sim.step();
+        trace.after_step(&sim)?;
         out.crack_events(&sim)?;
         if let Err(error) = stepped {
             let last = out.snapshot(&sim)?;

@@ -155,3 +155,102 @@ end = 1.0e-6
     assert!(fastest < 2.0 * v_i, "a particle moved at {fastest:.1} m/s, above 2 v_i = {:.0} m/s", 2.0 * v_i);
     assert!(worst_momentum < 1e-12, "momentum drift {worst_momentum:e} of the total");
 }
+
+/// `output.trace_particles` (`trace.csv`, `plugsim::output::ParticleTrace`),
+/// the instrument that finds what throws a particle, on the small Borvik
+/// plate without fracture: a particle under the projectile's face and one
+/// beside it. Every step's row splits the acceleration the step applied
+/// into its forces, `m a = f_ext + f_contact − f_int`; the coefficient
+/// velocities follow from those accelerations by the central difference,
+/// `V^{n+½} − V^{n−½} = ½ (Δt_{n−½} + Δt_{n+½}) a^n`, with the steps read
+/// off the rows' times; only the particle under the face feels contact;
+/// the last rows' physical position and velocity are the shape functions'
+/// interpolation of the final state; and the trace does not change the run.
+#[test]
+fn the_trace_splits_each_steps_acceleration_into_its_forces() {
+    use plugsim::io::HistoryTable;
+    use plugsim::math::{Real, Vec2};
+    use plugsim::run::{execute, Progress, RunConfig, RunInfo};
+    let sets = ["time.end=3e-6", "output.interval=1e-6"];
+    let plain = common::small_borvik_nofracture(&sets);
+    let model = build_simulation(&plain).unwrap().model;
+    let nearest = |at: Vec2| {
+        (0..model.particles.len())
+            .min_by(|&a, &b| (model.particles.x0[a] - at).norm().total_cmp(&(model.particles.x0[b] - at).norm()))
+    };
+    let under = nearest(Vec2::new(0.0, 0.0111)).unwrap();
+    let beside = nearest(Vec2::new(0.02, 0.0055)).unwrap();
+    let traced = format!("output.trace_particles=[{under}, {beside}]");
+    let case = common::small_borvik_nofracture(&[sets[0], sets[1], &traced]);
+    let run = |case: &Case, name: &str| {
+        let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+        let cfg = RunConfig::new(dir.clone(), true, RunInfo::current("test", &[]));
+        let mut last = None;
+        execute(case, &cfg, &mut |p| {
+            if let Progress::Finished { sim } = p {
+                last = Some(sim.clone());
+            }
+        })
+        .unwrap_or_else(|e| panic!("{e}"));
+        (dir, last.expect("the final state"))
+    };
+    let (dir, sim) = run(&case, "trace-traced");
+    let (plain_dir, plain_sim) = run(&plain, "trace-plain");
+    assert_eq!(sim.model.particles.v, plain_sim.model.particles.v, "the trace changes nothing");
+    assert!(!plain_dir.join("trace.csv").exists(), "no file without traced particles");
+
+    let table = HistoryTable::read(&dir.join("trace.csv")).unwrap();
+    let col = |name: &str| table.column(name).unwrap_or_else(|| panic!("column {name}"));
+    let row_count = col("time").len();
+    assert_eq!(row_count, 2 * sim.step as usize, "one row per traced particle and step");
+    let shape = &sim.model.particle_shape;
+    let p = &sim.model.particles;
+    let mut touched = 0;
+    for (k, &i) in [under, beside].iter().enumerate() {
+        let rows: Vec<usize> = (k..row_count).step_by(2).collect();
+        assert!(rows.iter().all(|&r| col("particle")[r] == i as Real));
+        let pair = |name: &str, r: usize| Vec2::new(col(&format!("{name}x"))[r], col(&format!("{name}y"))[r]);
+        let force = |name: &str, r: usize| Vec2::new(col(&format!("{name}_x"))[r], col(&format!("{name}_y"))[r]);
+        for (n, &r) in rows.iter().enumerate() {
+            let (fi, fc, fe) = (force("f_int", r), force("f_contact", r), force("f_ext", r));
+            let ma = pair("a", r) * col("mass")[r];
+            let scale = fi.norm() + fc.norm() + fe.norm() + 1e-30;
+            assert!((ma - (fe + fc - fi)).norm() <= 1e-12 * scale, "particle {i}, step {}", col("step")[r]);
+            touched += usize::from(fc.norm() > 0.0);
+            if k == 1 {
+                assert_eq!(fc, Vec2::zeros(), "the particle beside the projectile feels no contact");
+            }
+            if n >= 2 {
+                let (t, t1, t2) = (col("time")[r], col("time")[rows[n - 1]], col("time")[rows[n - 2]]);
+                let dt_v = 0.5 * ((t - t1) + (t1 - t2));
+                let dv = pair("coefficient_v", r) - pair("coefficient_v", rows[n - 1]);
+                let expected = pair("a", r) * dt_v;
+                assert!((dv - expected).norm() <= 1e-6 * expected.norm() + 1e-12, "particle {i}, row {n}");
+            }
+        }
+        let last = *rows.last().unwrap();
+        assert_eq!(pair("", last), p.x0[i] + shape.interpolate(i, &p.u), "physical position");
+        assert_eq!(pair("v", last), shape.interpolate(i, &p.v), "physical velocity");
+        assert_eq!(pair("coefficient_v", last), p.v[i]);
+        assert_eq!(col("live_share")[last], 1.0, "nothing is eroded without fracture");
+    }
+    assert!(touched > 10, "the particle under the face is in contact ({touched} rows)");
+}
+
+/// A traced particle that does not exist stops the run before it starts,
+/// naming the entry; one listed twice is a case error naming it.
+#[test]
+fn a_traced_particle_must_exist_once() {
+    use plugsim::run::{execute, RunConfig, RunInfo};
+    let case = common::small_borvik_nofracture(&["output.trace_particles=[3, 10000000]"]);
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("trace-missing");
+    let _ = std::fs::remove_dir_all(&dir);
+    let cfg = RunConfig::new(dir.clone(), true, RunInfo::current("test", &[]));
+    let e = execute(&case, &cfg, &mut |_| {}).expect_err("no such particle").to_string();
+    assert!(e.starts_with("output.trace_particles[1]: particle 10000000 does not exist"), "{e}");
+    assert!(!dir.exists(), "nothing is written");
+    let text = include_str!("../cases/borvik-1-nofracture.toml");
+    let twice = Case::from_str_with(text, "borvik", &["output.trace_particles=[3, 4, 3]".to_string()]);
+    let e = twice.expect_err("listed twice").to_string();
+    assert!(e.contains("output.trace_particles[2]: particle 3 is listed twice"), "{e}");
+}
