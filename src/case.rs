@@ -483,9 +483,13 @@ pub struct OutputSpec {
     /// perforation times.
     #[serde(default)]
     pub plot_times: Vec<Real>,
-    /// Particles (indices as generated, `0..n`) whose forces are written
-    /// at every step to `trace.csv` ([`crate::output::ParticleTrace`]): to
-    /// find what accelerates a particle. Default: none (no file).
+    /// Particles whose forces are written at every step to `trace.csv`
+    /// ([`crate::output::ParticleTrace`]): to find what accelerates a
+    /// particle. Indices as generated (`0..n`), or, with a fracture
+    /// criterion, of a crack-face child a split will make (a run summary
+    /// names its fastest particle's index; the same case makes the same
+    /// children), traced from the first step that integrates it. Default:
+    /// none (no file).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub trace_particles: Vec<usize>,
 }

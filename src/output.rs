@@ -545,13 +545,15 @@ pub const TRACE_COLUMNS: &[&str] = &[
 /// particle's speed are these); its own coefficient `V_I^{n+½}`, the one
 /// the step integrates; and the acceleration the step applied to that
 /// coefficient with its three terms, `m a = f_ext + f_contact − f_int`
-/// ([`Simulation::step`], a held component's acceleration being zero),
+/// ([`Simulation::step`], a held component's acceleration being zero;
+/// `m` the mass it integrated with),
 /// so that `V^{n+½} − V^{n−½} = ½ (Δt_{n−½} + Δt_{n+½}) a`: `f_int` is the internal force the
 /// step integrated (formed at the end of the step before, after any crack
 /// change, so it is read before the step), `f_contact` the contact force of
 /// the step (the rigid bodies', the deformable bodies' and the axis's, on
 /// the particle as a slave and as a neighbour a slave's force is spread
-/// to). Then its mass, its live share of material
+/// to). Then its mass (the step's; a crack change at the step's end
+/// lumps the masses anew, which the next row shows), its live share of material
 /// ([`crate::fracture::live_share`]) and its flags
 /// ([`crate::particles::ParticleFlags`]) after the step.
 pub struct ParticleTrace {
@@ -559,8 +561,10 @@ pub struct ParticleTrace {
     particles: Vec<usize>,
     /// `trace.csv`; `None` when no particle is traced.
     writer: Option<HistoryWriter>,
-    /// Each traced particle's internal force before the step.
-    f_int: Vec<Vec2>,
+    /// Each traced particle's internal force and mass before the step
+    /// (`None` while it does not exist): the ones the step integrates
+    /// with (a crack change at its end forms both anew).
+    f_int: Vec<Option<(Vec2, Real)>>,
 }
 
 impl ParticleTrace {
@@ -574,7 +578,7 @@ impl ParticleTrace {
     }
 
     fn writing(particles: &[usize], writer: Option<HistoryWriter>) -> Self {
-        ParticleTrace { particles: particles.to_vec(), writer, f_int: vec![Vec2::zeros(); particles.len()] }
+        ParticleTrace { particles: particles.to_vec(), writer, f_int: vec![None; particles.len()] }
     }
 
     /// Continue `dir/trace.csv` of a run resumed at step `step`: the rows
@@ -600,11 +604,13 @@ impl ParticleTrace {
         Ok(Self::writing(particles, Some(writer)))
     }
 
-    /// Before a step: keep the internal force the step will integrate.
+    /// Before a step: keep the internal force the step will integrate
+    /// (`None` for a particle a crack split has not made yet).
     pub fn before_step(&mut self, sim: &Simulation) {
         if self.writer.is_some() {
             for (f, &i) in self.f_int.iter_mut().zip(&self.particles) {
-                *f = sim.model.particles.f_int[i];
+                let p = &sim.model.particles;
+                *f = p.f_int.get(i).map(|&f| (f, p.mass[i]));
             }
         }
     }
@@ -616,6 +622,10 @@ impl ParticleTrace {
         };
         let p = &sim.model.particles;
         for (&i, fi) in self.particles.iter().zip(&self.f_int) {
+            // From the first step that integrates it on.
+            let Some((fi, mass)) = fi else {
+                continue;
+            };
             let shape = &sim.model.particle_shape;
             let (x, v) = (p.x0[i] + shape.interpolate(i, &p.u), shape.interpolate(i, &p.v));
             let (coefficient, a, fe) = (p.v[i], p.a[i], p.f_ext[i]);
@@ -639,7 +649,7 @@ impl ParticleTrace {
                 fc.y,
                 fe.x,
                 fe.y,
-                p.mass[i],
+                *mass,
                 share,
                 p.flags[i].0 as Real,
             ])?;

@@ -225,7 +225,7 @@ pub enum RunError {
     Unstable { error: SolverError, last_snapshot: PathBuf, dir: PathBuf },
     #[error(transparent)]
     Memory(#[from] MemoryError),
-    #[error("output.trace_particles[{entry}]: particle {particle} does not exist (the model has {count} particles, 0 to {})", count.saturating_sub(1))]
+    #[error("output.trace_particles[{entry}]: particle {particle} does not exist (the model has {count} particles, 0 to {}, and no fracture criterion to split more off)", count.saturating_sub(1))]
     TracedParticle { entry: usize, particle: usize, count: usize },
     #[error("time step {dt:e} s: {message}")]
     TimeStep { dt: Real, message: String },
@@ -312,7 +312,8 @@ fn build_simulation_without_cracks(case: &Case) -> Result<Simulation, RunError> 
     Ok(sim)
 }
 
-/// Every particle of `output.trace_particles` must exist (`0..count`).
+/// Every particle of `output.trace_particles` must exist (`0..count`):
+/// checked where no crack can split one off.
 fn check_traced_particles(traced: &[usize], count: usize) -> Result<(), RunError> {
     match traced.iter().enumerate().find(|&(_, &i)| i >= count) {
         Some((j, &particle)) => Err(RunError::TracedParticle { entry: j, particle, count }),
@@ -363,7 +364,10 @@ pub fn execute(case: &Case, cfg: &RunConfig, progress: &mut dyn FnMut(Progress))
     let t_setup = Instant::now();
     // Build before touching the disk: a case that cannot be discretized leaves nothing behind.
     let sim = build_simulation(&case)?;
-    check_traced_particles(&case.output.trace_particles, sim.model.particles.len())?;
+    // Crack splits add particles after the generated ones.
+    if sim.cracks.as_ref().is_none_or(|c| c.params.critical_value().is_none()) {
+        check_traced_particles(&case.output.trace_particles, sim.model.particles.len())?;
+    }
     prepare_output_dir(&cfg.out_dir, cfg.force)?;
     // A reused directory must not keep another run's checkpoints for `resume` to find.
     crate::checkpoint::remove_all(&crate::checkpoint::directory(&cfg.out_dir))?;

@@ -254,3 +254,47 @@ fn a_traced_particle_must_exist_once() {
     let e = twice.expect_err("listed twice").to_string();
     assert!(e.contains("output.trace_particles[2]: particle 3 is listed twice"), "{e}");
 }
+
+/// A crack-face child can be traced before it exists: the coarse
+/// plane-strain Case I splits its corner particles within 4 µs, and the
+/// first child (the first index after the generated particles) is traced
+/// from the first step that integrates it, with its forces adding up.
+#[test]
+fn a_crack_child_is_traced_from_its_first_step() {
+    use plugsim::io::HistoryTable;
+    use plugsim::run::{execute, Progress, RunConfig, RunInfo};
+    let text = builtin_case("borvik-1-plane-strain").expect("built-in case");
+    let short = ["time.end=4e-6".to_string(), "output.interval=2e-6".to_string()];
+    let plain = Case::from_str_with(text, "borvik-1-plane-strain", &short).unwrap();
+    let generated = build_simulation(&plain).unwrap().model.particles.len();
+    let mut sets = short.to_vec();
+    sets.push(format!("output.trace_particles=[{generated}, 0]"));
+    let case = Case::from_str_with(text, "borvik-1-plane-strain", &sets).unwrap();
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("trace-child");
+    let mut last = None;
+    let cfg = RunConfig::new(dir.clone(), true, RunInfo::current("test", &[]));
+    execute(&case, &cfg, &mut |p| {
+        if let Progress::Finished { sim } = p {
+            last = Some(sim.clone());
+        }
+    })
+    .unwrap_or_else(|e| panic!("{e}"));
+    let sim = last.unwrap();
+    assert!(sim.model.particles.len() > generated, "a split made a child");
+    let table = HistoryTable::read(&dir.join("trace.csv")).unwrap();
+    let col = |name: &str| table.column(name).unwrap();
+    let child: Vec<usize> = (0..col("time").len()).filter(|&r| col("particle")[r] == generated as f64).collect();
+    let first = col("step")[child[0]];
+    assert!(first > 1.0, "traced from its first step, {first}");
+    assert_eq!(child.len() as f64, sim.step as f64 - first + 1.0, "every step from then on");
+    assert_eq!(col("particle").iter().filter(|&&p| p == 0.0).count() as u64, sim.step, "particle 0 at every step");
+    for &r in &child {
+        let ma = (col("ax")[r] * col("mass")[r], col("ay")[r] * col("mass")[r]);
+        let f = (
+            col("f_ext_x")[r] + col("f_contact_x")[r] - col("f_int_x")[r],
+            col("f_ext_y")[r] + col("f_contact_y")[r] - col("f_int_y")[r],
+        );
+        let scale = col("f_int_x")[r].abs() + col("f_int_y")[r].abs() + col("f_contact_y")[r].abs() + 1e-30;
+        assert!((ma.0 - f.0).abs() + (ma.1 - f.1).abs() <= 1e-12 * scale, "row {r}");
+    }
+}
