@@ -519,6 +519,8 @@ pub const TRACE_COLUMNS: &[&str] = &[
     "y",
     "vx",
     "vy",
+    "coefficient_x",
+    "coefficient_y",
     "coefficient_vx",
     "coefficient_vy",
     "ax",
@@ -542,8 +544,11 @@ pub const TRACE_COLUMNS: &[&str] = &[
 /// and step reached; the particle's physical position `x = X_I + u(X_I)`
 /// and velocity `v(X_I) = Σ_J N_J(X_I) V_J` after it (SPEC §2: RK particles
 /// are not interpolating; the snapshots' positions and the fastest
-/// particle's speed are these); its own coefficient `V_I^{n+½}`, the one
-/// the step integrates; and the acceleration the step applied to that
+/// particle's speed are these); its own coefficients, `X_I + U_I` and
+/// `V_I^{n+½}`, the ones the step integrates (where they part from the
+/// physical values, the field hides the particle's own motion: a change
+/// of its shape functions, at a split or a detachment, shows it at once);
+/// and the acceleration the step applied to that
 /// coefficient with its three terms, `m a = f_ext + f_contact − f_int`
 /// ([`Simulation::step`], a held component's acceleration being zero;
 /// `m` the mass it integrated with),
@@ -639,6 +644,8 @@ impl ParticleTrace {
                 x.y,
                 v.x,
                 v.y,
+                p.x0[i].x + p.u[i].x,
+                p.x0[i].y + p.u[i].y,
                 coefficient.x,
                 coefficient.y,
                 a.x,

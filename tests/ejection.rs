@@ -162,8 +162,9 @@ end = 1.0e-6
 /// beside it. Every step's row splits the acceleration the step applied
 /// into its forces, `m a = f_ext + f_contact − f_int`; the coefficient
 /// velocities follow from those accelerations by the central difference,
-/// `V^{n+½} − V^{n−½} = ½ (Δt_{n−½} + Δt_{n+½}) a^n`, with the steps read
-/// off the rows' times; only the particle under the face feels contact;
+/// `V^{n+½} − V^{n−½} = ½ (Δt_{n−½} + Δt_{n+½}) a^n`, and the coefficient
+/// positions from those velocities, `U^{n+1} − U^n = Δt_{n+½} V^{n+½}`,
+/// with the steps read off the rows' times; only the particle under the face feels contact;
 /// the last rows' physical position and velocity are the shape functions'
 /// interpolation of the final state; and the trace does not change the run.
 #[test]
@@ -226,12 +227,16 @@ fn the_trace_splits_each_steps_acceleration_into_its_forces() {
                 let dv = pair("coefficient_v", r) - pair("coefficient_v", rows[n - 1]);
                 let expected = pair("a", r) * dt_v;
                 assert!((dv - expected).norm() <= 1e-6 * expected.norm() + 1e-12, "particle {i}, row {n}");
+                let dx = pair("coefficient_", r) - pair("coefficient_", rows[n - 1]);
+                let moved = pair("coefficient_v", r) * (t - t1);
+                assert!((dx - moved).norm() <= 1e-6 * moved.norm() + 1e-15, "particle {i}, row {n}");
             }
         }
         let last = *rows.last().unwrap();
         assert_eq!(pair("", last), p.x0[i] + shape.interpolate(i, &p.u), "physical position");
         assert_eq!(pair("v", last), shape.interpolate(i, &p.v), "physical velocity");
         assert_eq!(pair("coefficient_v", last), p.v[i]);
+        assert_eq!(pair("coefficient_", last), p.x0[i] + p.u[i]);
         assert_eq!(col("live_share")[last], 1.0, "nothing is eroded without fracture");
     }
     assert!(touched > 10, "the particle under the face is in contact ({touched} rows)");
