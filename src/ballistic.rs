@@ -1599,7 +1599,10 @@ pub fn outran_doubling(shots: &[Shot]) -> Option<String> {
             "Particles faster than the free-surface doubling 2 v_i (an elastic wave at a free face doubles the \
              particle speed, so a particle past it was thrown by something else: a crack-face particle squeezed \
              out, a light particle ringing under a contact; docs/validation.md, \"Fastest particle\"; each run's \
-             `history.csv` has `max_particle_speed`):\n\n{}\n",
+             `history.csv` has `max_particle_speed`, and `output.trace_particles` writes the forces on a particle \
+             at every step). Under a rounded nose the first contact throws a jet ahead of its edge, bounded by \
+             twice the edge's speed rather than 2 v_i (docs/validation.md, \"Three throws traced with \
+             `output.trace_particles`\"):\n\n{}\n",
             fast.concat()
         )
     })
