@@ -155,8 +155,12 @@ pub const MAGIC: [u8; 8] = *b"PLUGCKPT";
 /// version 16 the axis as a wall of the contact
 /// ([`crate::contact::ContactSystem::with_axis`]: its switch, last forces
 /// and work), version 17 the fastest particle's live share of material
-/// ([`crate::step::FastestParticle::live_share`]).
-pub const FORMAT_VERSION: u32 = 17;
+/// ([`crate::step::FastestParticle::live_share`]), version 18 no field of
+/// its own: the history's new column `max_coefficient_gap`
+/// ([`crate::output::HISTORY_COLUMNS`]; a checkpoint continues its
+/// directory's `history.csv`, so an older one, whose file lacks the
+/// column, is refused by its version rather than by the file's header).
+pub const FORMAT_VERSION: u32 = 18;
 /// Subdirectory of a run's output directory that holds its checkpoints.
 pub const DIRECTORY: &str = "checkpoints";
 /// File name extension of a checkpoint.

@@ -1347,6 +1347,15 @@ fn drive(
         println!("  WARNING: the energy balance drifted by more than 5 % of the input energy");
     }
     println!("  fastest particle: {} (history.csv: max_particle_speed)", s.fastest.describe());
+    if let Some((gap, t)) = s.coefficient_gap {
+        let (end, i, origin) = &s.coefficient_gap_at_end;
+        println!(
+            "  coefficients apart from the field: at most {gap:.2} spacings, at t = {:.3} us; {end:.2} at the end, \
+             particle {i} ({origin}) (history.csv: max_coefficient_gap; the snapshots show the field, and a split or \
+             a detachment beside such a particle shows its coefficient at once)",
+            t * 1e6
+        );
+    }
     println!(
         "  wall time {:.2} s: setup {:.2} s, time loop {:.2} s, output {:.2} s",
         total.as_secs_f64(),

@@ -38,7 +38,10 @@ pub enum OutputError {
 /// them touched a rigid body in the last step (see
 /// [`crate::contact::ContactSystem::admit_exposed`]), and
 /// `max_particle_speed`, the largest physical particle speed `max_I |v(X_I)|`
-/// at that step, m/s ([`crate::step::fastest_particle`]). Each rigid body `NAME` adds `NAME_x, NAME_y` (m), `NAME_vx, NAME_vy` (m/s),
+/// at that step, m/s ([`crate::step::fastest_particle`]);
+/// `max_coefficient_gap`, the largest distance between a particle's own
+/// coefficient `X_I + U_I` and the field at it, `x(X_I)`, in its spacings
+/// ([`crate::step::coefficient_gap`]). Each rigid body `NAME` adds `NAME_x, NAME_y` (m), `NAME_vx, NAME_vy` (m/s),
 /// `NAME_fx, NAME_fy` (contact force on the body, N), `NAME_contacts` and
 /// `NAME_f_axial`, the contact force along its flight direction (the
 /// direction of its initial velocity; negative while braked; 0 for a body
@@ -62,6 +65,7 @@ pub const HISTORY_COLUMNS: &[&str] = &[
     "exposed_slaves",
     "exposed_contacts",
     "max_particle_speed",
+    "max_coefficient_gap",
 ];
 
 /// Columns of `cracks.csv`: one row per crack event; `particles` lists the
@@ -342,6 +346,7 @@ impl OutputWriter {
             sim.contact.as_ref().map_or((0, 0), |c| c.exposed_counts(&sim.model.particles.flags));
         row.extend([admitted as Real, touching as Real]);
         row.push(crate::step::fastest_particle(&sim.model).0);
+        row.push(crate::step::coefficient_gap(&sim.model).0);
         for b in 0..self.names.len() {
             if let Some(s) = self.flight_sample(sim, b) {
                 row.extend([

@@ -149,6 +149,14 @@ pub struct RunSummary {
     pub max_drift: Real,
     /// The fastest particle of the run ([`crate::step::Simulation::fastest`]).
     pub fastest: crate::step::FastestParticle,
+    /// The largest gap between a particle's coefficients and the field at
+    /// it over the history's rows, in its spacings, and when
+    /// ([`crate::step::coefficient_gap`], `history.csv`'s
+    /// `max_coefficient_gap`); `None` without a row.
+    pub coefficient_gap: Option<(Real, Real)>,
+    /// The largest gap at the end, in spacings, its particle and where
+    /// that particle's material came from (`step::particle_origin`).
+    pub coefficient_gap_at_end: (Real, usize, String),
     /// Estimated peak memory of the case, bytes
     /// ([`crate::memory::Footprint::bytes`]).
     pub memory_estimate: Real,
@@ -613,6 +621,12 @@ fn time_loop(
         .unwrap_or_default();
     let names: Vec<String> = rigid_velocities.iter().map(|(n, _)| n.clone()).collect();
     let history = crate::output::read_history(&cfg.out_dir)?;
+    let coefficient_gap = history.column("max_coefficient_gap").zip(history.column("time")).and_then(|(g, t)| {
+        g.iter().zip(t).fold(None, |best: Option<(Real, Real)>, (&g, &t)| match best {
+            Some((b, _)) if b >= g => best,
+            _ => Some((g, t)),
+        })
+    });
     let last_contacts = crate::output::last_contact_times(&history, &names);
     let perforation = crate::output::perforation_time(&history);
     let through = out.through(&sim).to_vec();
@@ -665,6 +679,13 @@ fn time_loop(
         bulk_viscosity: sim.bulk_viscosity,
         max_drift: schedule.max_drift,
         fastest: sim.fastest,
+        coefficient_gap,
+        coefficient_gap_at_end: {
+            let (gap, i) = crate::step::coefficient_gap(&sim.model);
+            let p = &sim.model.particles;
+            let crack_face = p.flags.get(i).is_some_and(|f| f.has(crate::particles::ParticleFlags::CRACK_FACE));
+            (gap, i, crate::step::particle_origin(crack_face, p.x0.get(i).copied().unwrap_or_default()))
+        },
         memory_estimate: preflight(case)?.bytes(),
         peak_resident: crate::memory::peak_resident(),
         out_dir: cfg.out_dir.clone(),

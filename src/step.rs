@@ -244,10 +244,10 @@ pub fn particle_origin(crack_face: bool, reference: Vec2) -> String {
     format!("{kind} from ({:.3}, {:.3}) mm", reference.x * 1e3, reference.y * 1e3)
 }
 
-/// `(sqrt(max_I s2(I)), I)` over `n` particles, for a squared speed `s2`:
-/// the lowest index among equals, so the same for any number of threads;
-/// `(0, 0)` without particles.
-fn fastest_by(n: usize, s2: impl Fn(usize) -> Real + Sync) -> (Real, usize) {
+/// `(sqrt(max_I s2(I)), I)` over `n` particles, for a squared norm `s2`
+/// (a speed, a gap): the lowest index among equals, so the same for any
+/// number of threads; `(0, 0)` without particles.
+fn largest_by(n: usize, s2: impl Fn(usize) -> Real + Sync) -> (Real, usize) {
     let (s2, i) = (0..n)
         .into_par_iter()
         .map(|i| (s2(i), i))
@@ -255,12 +255,27 @@ fn fastest_by(n: usize, s2: impl Fn(usize) -> Real + Sync) -> (Real, usize) {
     (s2.sqrt(), i)
 }
 
+/// How far the particles' own coefficients have left the field they
+/// interpolate: `(max_I |U_I − u(X_I)| / h_I, I)` with `u(X_I) = Σ_J
+/// N_J(X_I) U_J` and `h_I` the particle's spacing. RK particles are not
+/// interpolating (SPEC §2), so the gap is never exactly 0 where the field
+/// curves, but it stays a small fraction of a spacing in a body that
+/// holds its particles; a particle whose material no longer holds it
+/// can drift several spacings from the field, which hides its motion
+/// until a change of its shape functions (a split, a detachment) shows
+/// it at once (docs/validation.md, "Three throws traced with
+/// `output.trace_particles`"). A detached particle is its own field: 0.
+pub fn coefficient_gap(model: &Model) -> (Real, usize) {
+    let (tab, p) = (&model.particle_shape, &model.particles);
+    largest_by(p.len(), |i| ((p.u[i] - tab.interpolate(i, &p.u)) / p.spacing[i]).norm_squared())
+}
+
 /// The physically fastest particle of `model` now, `(|v(X_I)|, I)`
 /// ([`FastestParticle`]); one pass over the particle shape table, no
 /// allocation.
 pub fn fastest_particle(model: &Model) -> (Real, usize) {
     let (tab, v) = (&model.particle_shape, &model.particles.v);
-    fastest_by(v.len(), |i| tab.interpolate(i, v).norm_squared())
+    largest_by(v.len(), |i| tab.interpolate(i, v).norm_squared())
 }
 
 /// The running simulation.
@@ -1016,7 +1031,7 @@ impl Simulation {
         let (total, input) = (self.energies.total(), self.input_energy());
         if input > 0.0 && (total.is_nan() || total > ENERGY_BLOWUP_FACTOR * input) {
             let v = &self.model.particles.v;
-            let (speed, particle) = fastest_by(v.len(), |i| v[i].norm_squared());
+            let (speed, particle) = largest_by(v.len(), |i| v[i].norm_squared());
             return Err(SolverError::EnergyBlowUp { total, input, particle, speed, step: self.step, time: self.time });
         }
         Ok(())

@@ -424,19 +424,20 @@ fn checkpoint_of_another_format_version_is_refused_naming_both() {
     }
 }
 
-/// Format 16 (postcard, before the fastest particle's live share) is
-/// refused, naming both versions, rather than misread.
+/// Format 17 (before the history's `max_coefficient_gap`) is refused,
+/// naming both versions, rather than resumed into a history without the
+/// column.
 #[test]
 fn older_format_version_checkpoint_is_refused_naming_both_versions() {
-    assert_eq!(FORMAT_VERSION, 17);
+    assert_eq!(FORMAT_VERSION, 18);
     let case = case(STRIKE, &["time.end=1e-6"]);
-    let dir = scratch("version-16");
+    let dir = scratch("version-17");
     let path = run_until(&case, &dir, 2);
-    corrupt(&path, 8, &16u32.to_le_bytes());
+    corrupt(&path, 8, &17u32.to_le_bytes());
     let e = checkpoint::read(&path).unwrap_err().to_string();
-    assert!(e.contains("format version 16 ") && e.contains("reads format version 17"), "{e}");
+    assert!(e.contains("format version 17 ") && e.contains("reads format version 18"), "{e}");
     let e = resume(&config(&dir, None), &mut |_| {}).unwrap_err().to_string();
-    assert!(e.contains("format version 16 ") && e.contains("format version 17"), "{e}");
+    assert!(e.contains("format version 17 ") && e.contains("format version 18"), "{e}");
 }
 
 #[test]

@@ -197,6 +197,10 @@ fn the_trace_splits_each_steps_acceleration_into_its_forces() {
     };
     let (dir, sim) = run(&case, "trace-traced");
     let (plain_dir, plain_sim) = run(&plain, "trace-plain");
+    // The history's coefficient gap: the field holds its particles here.
+    let history = HistoryTable::read(&dir.join("history.csv")).unwrap();
+    let gaps = history.column("max_coefficient_gap").expect("the history has the column");
+    assert!(gaps.iter().all(|&g| (0.0..0.2).contains(&g)), "an intact plate: {:?}", gaps.last());
     assert_eq!(sim.model.particles.v, plain_sim.model.particles.v, "the trace changes nothing");
     assert!(!plain_dir.join("trace.csv").exists(), "no file without traced particles");
 
@@ -356,4 +360,41 @@ fn the_rounded_noses_first_contact_throws_no_faster_than_its_jet() {
     assert!(record > 2.0 * v, "the first contact throws past 2 v_i: {record:.0} m/s");
     assert!(worst < 1.0, "a record at {worst:.2} of twice the contact edge's speed");
     assert!(worst > 0.3, "the bound is not vacuous: {worst:.2}");
+}
+
+/// `step::coefficient_gap`, the history's `max_coefficient_gap`: how far
+/// a particle's own coefficient has left the field at it, in spacings.
+/// RK shape functions reproduce linear fields, so a linear displacement
+/// (a stretch, a shear and a shift) leaves no gap; moving one particle's
+/// coefficient by `δ` away from that field opens exactly
+/// `|δ| (1 − N_I(X_I)) / h_I` at it, the largest of the model.
+#[test]
+fn the_coefficient_gap_is_zero_for_a_linear_field_and_exact_for_one_moved_particle() {
+    use plugsim::math::{Real, Vec2};
+    use plugsim::step::coefficient_gap;
+    let case = common::small_borvik_nofracture(&[]);
+    let mut sim = build_simulation(&case).unwrap();
+    let n = sim.model.particles.len();
+    for i in 0..n {
+        let x = sim.model.particles.x0[i];
+        sim.model.particles.u[i] = Vec2::new(0.01 * x.x + 0.002 * x.y + 1e-4, -0.003 * x.y + 0.004 * x.x - 2e-4);
+    }
+    let (gap, _) = coefficient_gap(&sim.model);
+    assert!(gap < 1e-9, "a linear field is reproduced: gap {gap:e} spacings");
+    // An interior particle near the plate's middle.
+    let at = Vec2::new(0.0, 0.0055);
+    let i = (0..n)
+        .min_by(|&a, &b| (sim.model.particles.x0[a] - at).norm().total_cmp(&(sim.model.particles.x0[b] - at).norm()))
+        .unwrap();
+    let h = sim.model.particles.spacing[i];
+    let delta = Vec2::new(0.3 * h, -0.4 * h);
+    sim.model.particles.u[i] += delta;
+    let mut indicator = vec![Vec2::zeros(); n];
+    indicator[i] = Vec2::new(1.0, 0.0);
+    let own = sim.model.particle_shape.interpolate(i, &indicator).x;
+    assert!(own > 0.0 && own < 1.0, "RK particles are not interpolating: N_I(X_I) = {own}");
+    let (gap, at) = coefficient_gap(&sim.model);
+    let expected: Real = delta.norm() * (1.0 - own) / h;
+    assert_eq!(at, i);
+    assert!((gap - expected).abs() < 1e-9 * expected, "{gap} against {expected}");
 }
