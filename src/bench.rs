@@ -212,7 +212,12 @@ fn timed_steps(sim: &mut Simulation, n: usize) -> Result<Real, RunError> {
 }
 
 fn unstable(error: crate::step::SolverError) -> RunError {
-    RunError::Unstable { error, last_snapshot: "(none: benchmark)".into(), dir: "(none)".into() }
+    RunError::Unstable {
+        error: Box::new(error),
+        last_snapshot: "(none: benchmark)".into(),
+        at_failure: true,
+        dir: "(none)".into(),
+    }
 }
 
 /// Internal-force assembly: the production gather (each particle sums its

@@ -556,6 +556,16 @@ impl Model {
         (0..self.particles.len()).into_par_iter().map(|i| self.project_at(i, &f)).collect()
     }
 
+    /// Whether the shape tables and the gather cover exactly the particles
+    /// and points there are: false only between a crack split (which adds
+    /// particles) and the rebuild of their rows, which a failed rebuild
+    /// leaves undone (`fracture::FractureError`); then no field can be
+    /// projected or interpolated.
+    pub fn tables_match(&self) -> bool {
+        let (n, nq) = (self.particles.len(), self.quad.len());
+        self.particle_shape.rows() == n && self.qp_shape.rows() == nq && self.gather.offsets.len() == n + 1
+    }
+
     /// Smallest particle spacing, m.
     pub fn min_spacing(&self) -> Real {
         self.particles.spacing.iter().cloned().fold(Real::INFINITY, Real::min)

@@ -288,6 +288,12 @@ impl OutputWriter {
         Ok(path)
     }
 
+    /// The newest snapshot's particle file (`particles_00000.vtu` before
+    /// any).
+    pub fn last_snapshot(&self) -> PathBuf {
+        self.dir.join(snapshot_name(self.snapshots.saturating_sub(1)))
+    }
+
     /// When the cracks first cut a plug out (s; the `perforation_time`
     /// column), `None` before.
     pub fn perforation(&self) -> Option<Real> {

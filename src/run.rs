@@ -229,8 +229,8 @@ pub enum RunError {
     Plot(#[from] crate::io::PlotError),
     #[error(transparent)]
     Output(#[from] crate::output::OutputError),
-    #[error("{error}\n  the state at failure is in {}; all earlier output is kept in {}", last_snapshot.display(), dir.display())]
-    Unstable { error: SolverError, last_snapshot: PathBuf, dir: PathBuf },
+    #[error("{error}\n  {}; all earlier output is kept in {}", state_note(last_snapshot, *at_failure), dir.display())]
+    Unstable { error: Box<SolverError>, last_snapshot: PathBuf, at_failure: bool, dir: PathBuf },
     #[error(transparent)]
     Memory(#[from] MemoryError),
     #[error("output.trace_particles[{entry}]: particle {particle} does not exist (the model has {count} particles, 0 to {}, and no fracture criterion to split more off)", count.saturating_sub(1))]
@@ -244,6 +244,18 @@ pub enum RunError {
         checkpoint.display(), dir.display()
     )]
     Interrupted { step: u64, time: Real, checkpoint: PathBuf, dir: PathBuf },
+}
+
+/// What [`RunError::Unstable`] says of the state at failure.
+fn state_note(last_snapshot: &Path, at_failure: bool) -> String {
+    match at_failure {
+        true => format!("the state at failure is in {}", last_snapshot.display()),
+        false => format!(
+            "the failing step stopped between a crack split and the rebuild of its rows, so its state cannot be \
+             written; the last snapshot before it is {}",
+            last_snapshot.display()
+        ),
+    }
 }
 
 /// Make sure `dir` can take a run: create it, or refuse if it holds files
@@ -573,13 +585,29 @@ fn time_loop(
         }
         trace.before_step(&sim);
         let stepped = sim.step();
-        trace.after_step(&sim)?;
-        out.crack_events(&sim)?;
+        // A crack stage that failed between a split and its rows leaves
+        // no state that fields can be drawn from (nor the plug found, nor
+        // a particle traced): the last snapshot is then the one before.
+        let at_failure = stepped.is_ok() || sim.model.tables_match();
+        if at_failure {
+            trace.after_step(&sim)?;
+            out.crack_events(&sim)?;
+        }
         if let Err(error) = stepped {
-            let last = out.snapshot(&sim)?;
+            let last = match at_failure {
+                true => out.snapshot(&sim)?,
+                false => out.last_snapshot(),
+            };
             out.flush()?;
-            out.history_row(&sim)?;
-            return Err(RunError::Unstable { error, last_snapshot: last, dir: cfg.out_dir.clone() });
+            if at_failure {
+                out.history_row(&sim)?;
+            }
+            return Err(RunError::Unstable {
+                error: Box::new(error),
+                last_snapshot: last,
+                at_failure,
+                dir: cfg.out_dir.clone(),
+            });
         }
         // The early stop samples the states the history records (the next
         // row is this state), so it and the verdict read from the history

@@ -1565,8 +1565,22 @@ impl CrackGrowth {
         // body any more (`detach_isolated`): its row is empty.
         let emptied: Vec<usize> =
             rows_q.iter().copied().filter(|&q| model.quad.eroded[q] && only_detached(&qp_shape, &p.flags, q)).collect();
+        // A point that no particle sees any more (the crack has cut it off
+        // from every particle of its body) has no displacement field to
+        // follow: it takes an empty row and is eroded, and the rebuilt
+        // particles keep its mass (below; `shape::rk::rebuild_rows_setting_aside_orphans`).
         let empty = |q: usize| emptied.binary_search(&q).is_ok().then(Row::new);
-        let r1 = rebuild_rows(&mut qp_shape, &mut spare.qp_shape, &rows_q, qx, px, &p.support, &p.volume, &vis, &empty);
+        let r1 = crate::shape::rk::rebuild_rows_setting_aside_orphans(
+            &mut qp_shape,
+            &mut spare.qp_shape,
+            &rows_q,
+            qx,
+            px,
+            &p.support,
+            &p.volume,
+            &vis,
+            &empty,
+        );
         // A detached particle moves by its own displacement alone: its
         // row is itself, `N = 1`, `∇N = 0` (the rows of the others no
         // longer see it).
@@ -1584,8 +1598,12 @@ impl CrackGrowth {
         );
         model.qp_shape = qp_shape;
         model.particle_shape = particle_shape;
+        let (r1, orphans) = r1?;
+        for &q in &orphans {
+            model.quad.erode(q);
+        }
         for (rows, reduced, map) in
-            [(&rows_q, r1?, &mut self.reduced_quadrature_rows), (&rows_p, r2?, &mut self.reduced_particle_rows)]
+            [(&rows_q, r1, &mut self.reduced_quadrature_rows), (&rows_p, r2?, &mut self.reduced_particle_rows)]
         {
             for r in rows {
                 map.remove(r);
@@ -1625,9 +1643,10 @@ impl CrackGrowth {
             }
             model.particles.mass[i] = m.max(floor);
         }
-        if !floored.is_empty() {
+        if !floored.is_empty() || !orphans.is_empty() {
             // Take the floor's extra mass from the other re-lumped particles,
-            // in proportion to their masses: the total stays exact.
+            // in proportion to their masses, and give them an orphaned
+            // point's: the total stays exact.
             let p = &mut model.particles;
             let after: Real = touched.iter().map(|&i| p.mass[i]).sum();
             let rest: Real = touched.iter().filter(|i| !floored.contains(i)).map(|&i| p.mass[i]).sum();
