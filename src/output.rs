@@ -570,7 +570,7 @@ pub const TRACE_COLUMNS: &[&str] = &[
 /// the particle as a slave and as a neighbour a slave's force is spread
 /// to). Then its mass (the step's; a crack change at the step's end
 /// lumps the masses anew, which the next row shows), its live share of material
-/// ([`crate::fracture::live_share`]) and its flags
+/// ([`crate::fracture::growth::live_share`]) and its flags
 /// ([`crate::particles::ParticleFlags`]) after the step.
 pub struct ParticleTrace {
     /// The particles traced, in the case's order.

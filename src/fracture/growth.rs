@@ -1570,17 +1570,9 @@ impl CrackGrowth {
         // follow: it takes an empty row and is eroded, and the rebuilt
         // particles keep its mass (below; `shape::rk::rebuild_rows_setting_aside_orphans`).
         let empty = |q: usize| emptied.binary_search(&q).is_ok().then(Row::new);
-        let r1 = crate::shape::rk::rebuild_rows_setting_aside_orphans(
-            &mut qp_shape,
-            &mut spare.qp_shape,
-            &rows_q,
-            qx,
-            px,
-            &p.support,
-            &p.volume,
-            &vis,
-            &empty,
-        );
+        let r1 = crate::shape::rk::rebuild_rows_setting_aside_orphans(&rows_q, &empty, |given| {
+            rebuild_rows(&mut qp_shape, &mut spare.qp_shape, &rows_q, qx, px, &p.support, &p.volume, &vis, given)
+        });
         // A detached particle moves by its own displacement alone: its
         // row is itself, `N = 1`, `∇N = 0` (the rows of the others no
         // longer see it).

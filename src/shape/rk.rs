@@ -349,10 +349,11 @@ pub fn rebuild_rows(
 /// The rows a rebuild built with a reduced basis, and that basis.
 pub type ReducedRows = Vec<(usize, Basis)>;
 
-/// [`rebuild_rows`], where a point that no particle sees (a crack has cut
-/// it off from every particle of its body) takes an empty row instead of
-/// failing the rebuild with [`ShapeError::SingularMoment`] at 0
-/// particles: such a point has no displacement field to follow. Returns
+/// `rebuild(given)`, a [`rebuild_rows`] of rows `which` with rows
+/// `given`, where a point that no particle sees (a crack has cut it off
+/// from every particle of its body) takes an empty row instead of failing
+/// the rebuild with [`ShapeError::SingularMoment`] at 0 particles: such a
+/// point has no displacement field to follow. Returns
 /// the reduced rows and those points ("orphans"), ascending; the caller
 /// erodes them (`crate::fracture::CrackGrowth`). Found by the builder,
 /// which leaves `table` as it was on an error: each is set aside and the
@@ -361,22 +362,15 @@ pub type ReducedRows = Vec<(usize, Basis)>;
 /// hemispherical nose at 48 rows and 292.1 m/s, at 25.9 µs:
 /// docs/validation.md, "A point cut off from every particle"). Test:
 /// `a_point_no_particle_sees_takes_an_empty_row`.
-#[allow(clippy::too_many_arguments)]
 pub fn rebuild_rows_setting_aside_orphans(
-    table: &mut ShapeTable,
-    spare: &mut ShapeTable,
     which: &[usize],
-    points: &[Vec2],
-    x0: &[Vec2],
-    support: &[Real],
-    volume: &[Real],
-    vis: &dyn Visibility,
     given: &(dyn Fn(usize) -> Option<Row> + Sync),
+    mut rebuild: impl FnMut(&(dyn Fn(usize) -> Option<Row> + Sync)) -> Result<ReducedRows, ShapeError>,
 ) -> Result<(ReducedRows, Vec<usize>), ShapeError> {
     let mut orphans: Vec<usize> = Vec::new();
     loop {
         let row_of = |r: usize| if orphans.binary_search(&r).is_ok() { Some(Row::new()) } else { given(r) };
-        match rebuild_rows(table, spare, which, points, x0, support, volume, vis, &row_of) {
+        match rebuild(&row_of) {
             Err(ShapeError::SingularMoment { point, neighbours: 0, .. })
                 if which.binary_search(&point).is_ok() && orphans.binary_search(&point).is_err() =>
             {
@@ -482,17 +476,10 @@ mod tests {
         let e = rebuild_rows(&mut t, &mut ShapeTable::default(), &[0, 1, 2], &pts, &x0, &a, &v, &hide, &|_| None);
         assert!(matches!(e, Err(ShapeError::SingularMoment { point: 1, neighbours: 0, .. })), "{e:?}");
         assert_eq!(t, reference, "the table is left as it was");
-        let (reduced, orphans) = rebuild_rows_setting_aside_orphans(
-            &mut t,
-            &mut ShapeTable::default(),
-            &[0, 1, 2],
-            &pts,
-            &x0,
-            &a,
-            &v,
-            &hide,
-            &|_| None,
-        )
+        let mut spare = ShapeTable::default();
+        let (reduced, orphans) = rebuild_rows_setting_aside_orphans(&[0, 1, 2], &|_| None, |given| {
+            rebuild_rows(&mut t, &mut spare, &[0, 1, 2], &pts, &x0, &a, &v, &hide, given)
+        })
         .unwrap();
         assert!(reduced.is_empty());
         assert_eq!(orphans, vec![1]);
