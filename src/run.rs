@@ -588,24 +588,24 @@ fn time_loop(
         // A crack stage that failed between a split and its rows leaves
         // no state that fields can be drawn from (nor the plug found, nor
         // a particle traced): the last snapshot is then the one before.
-        let at_failure = stepped.is_ok() || sim.model.tables_match();
-        if at_failure {
+        let drawable = stepped.is_ok() || sim.model.tables_match();
+        if drawable {
             trace.after_step(&sim)?;
             out.crack_events(&sim)?;
         }
         if let Err(error) = stepped {
-            let last = match at_failure {
+            let last = match drawable {
                 true => out.snapshot(&sim)?,
                 false => out.last_snapshot(),
             };
             out.flush()?;
-            if at_failure {
+            if drawable {
                 out.history_row(&sim)?;
             }
             return Err(RunError::Unstable {
                 error: Box::new(error),
                 last_snapshot: last,
-                at_failure,
+                at_failure: drawable,
                 dir: cfg.out_dir.clone(),
             });
         }

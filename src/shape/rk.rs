@@ -325,7 +325,7 @@ pub fn rebuild_rows(
     volume: &[Real],
     vis: &dyn Visibility,
     given: &(dyn Fn(usize) -> Option<Row> + Sync),
-) -> Result<Vec<(usize, Basis)>, ShapeError> {
+) -> Result<ReducedRows, ShapeError> {
     let search = SupportSearch::new(x0, support);
     // Rows are independent: built in parallel, collected in `which` order.
     let built: Vec<(Row, Option<Basis>)> = which
@@ -337,7 +337,7 @@ pub fn rebuild_rows(
             }
         })
         .collect::<Result<_, _>>()?;
-    let reduced: Vec<(usize, Basis)> = which
+    let reduced: ReducedRows = which
         .iter()
         .zip(&built)
         .filter_map(|(&r, &(_, b))| b.filter(|&b| b != Basis::Bilinear).map(|b| (r, b)))
