@@ -1356,6 +1356,14 @@ fn drive(
             t * 1e6
         );
     }
+    if !s.untraced.is_empty() {
+        let list: Vec<String> = s.untraced.iter().map(|i| i.to_string()).collect();
+        println!(
+            "  WARNING: output.trace_particles: particle(s) {} never came to exist (the run ended with {} particles), so trace.csv has no rows of them",
+            list.join(", "),
+            s.particles
+        );
+    }
     println!(
         "  wall time {:.2} s: setup {:.2} s, time loop {:.2} s, output {:.2} s",
         total.as_secs_f64(),

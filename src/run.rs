@@ -157,6 +157,11 @@ pub struct RunSummary {
     /// The largest gap at the end, in spacings, its particle and where
     /// that particle's material came from (`step::particle_origin`).
     pub coefficient_gap_at_end: (Real, usize, String),
+    /// The entries of `output.trace_particles` that never came to exist: a
+    /// run with a fracture criterion accepts an index past the generated
+    /// particles (a crack-face child to come),
+    /// and `trace.csv` has no row of one no split made.
+    pub untraced: Vec<usize>,
     /// Estimated peak memory of the case, bytes
     /// ([`crate::memory::Footprint::bytes`]).
     pub memory_estimate: Real,
@@ -714,6 +719,7 @@ fn time_loop(
             let crack_face = p.flags.get(i).is_some_and(|f| f.has(crate::particles::ParticleFlags::CRACK_FACE));
             (gap, i, crate::step::particle_origin(crack_face, p.x0.get(i).copied().unwrap_or_default()))
         },
+        untraced: case.output.trace_particles.iter().copied().filter(|&i| i >= sim.model.particles.len()).collect(),
         memory_estimate: preflight(case)?.bytes(),
         peak_resident: crate::memory::peak_resident(),
         out_dir: cfg.out_dir.clone(),

@@ -267,7 +267,8 @@ fn a_traced_particle_must_exist_once() {
 /// A crack-face child can be traced before it exists: the coarse
 /// plane-strain Case I splits its corner particles within 4 µs, and the
 /// first child (the first index after the generated particles) is traced
-/// from the first step that integrates it, with its forces adding up.
+/// from the first step that integrates it, with its forces adding up. An
+/// index no split reaches has no rows, and the run's summary names it.
 #[test]
 fn a_crack_child_is_traced_from_its_first_step() {
     use plugsim::io::HistoryTable;
@@ -277,12 +278,13 @@ fn a_crack_child_is_traced_from_its_first_step() {
     let plain = Case::from_str_with(text, "borvik-1-plane-strain", &short).unwrap();
     let generated = build_simulation(&plain).unwrap().model.particles.len();
     let mut sets = short.to_vec();
-    sets.push(format!("output.trace_particles=[{generated}, 0]"));
+    let never = generated + 1_000_000;
+    sets.push(format!("output.trace_particles=[{generated}, 0, {never}]"));
     let case = Case::from_str_with(text, "borvik-1-plane-strain", &sets).unwrap();
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("trace-child");
     let mut last = None;
     let cfg = RunConfig::new(dir.clone(), true, RunInfo::current("test", &[]));
-    execute(&case, &cfg, &mut |p| {
+    let summary = execute(&case, &cfg, &mut |p| {
         if let Progress::Finished { sim } = p {
             last = Some(sim.clone());
         }
@@ -290,9 +292,12 @@ fn a_crack_child_is_traced_from_its_first_step() {
     .unwrap_or_else(|e| panic!("{e}"));
     let sim = last.unwrap();
     assert!(sim.model.particles.len() > generated, "a split made a child");
+    // The index no split reached is reported, and has no rows; the child has.
+    assert_eq!(summary.untraced, vec![never]);
     let table = HistoryTable::read(&dir.join("trace.csv")).unwrap();
     let col = |name: &str| table.column(name).unwrap();
     let child: Vec<usize> = (0..col("time").len()).filter(|&r| col("particle")[r] == generated as f64).collect();
+    assert!(!col("particle").contains(&(never as f64)), "no rows of a particle never made");
     let first = col("step")[child[0]];
     assert!(first > 1.0, "traced from its first step, {first}");
     assert_eq!(child.len() as f64, sim.step as f64 - first + 1.0, "every step from then on");
