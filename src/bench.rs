@@ -220,6 +220,38 @@ fn unstable(error: crate::step::SolverError) -> RunError {
     }
 }
 
+/// What the per-step and per-history-row diagnostics cost against a
+/// whole step, on the state after a few steps: the fastest particle
+/// ([`crate::step::fastest_particle`], every step: one interpolation of
+/// the velocity field at each particle) and the gap between the
+/// coefficients and the field ([`crate::step::coefficient_gap`], once per
+/// `history.csv` row: one interpolation of the displacement field). As
+/// passes/s, and each pass as a fraction of one step with `threads`
+/// threads.
+pub fn diagnostics(case: &Case, threads: usize, n: usize) -> Result<Vec<Figure>, RunError> {
+    with_threads(threads, || {
+        let mut sim = build_simulation(case)?;
+        warm_up(&mut sim)?;
+        let step = timed_steps(&mut sim, n)? / n as Real;
+        let mut out = Vec::new();
+        type Pass = fn(&crate::model::Model) -> (Real, usize);
+        let passes: [(&str, Pass); 2] = [
+            ("fastest particle (every step)", crate::step::fastest_particle),
+            ("coefficient gap (every history row)", crate::step::coefficient_gap),
+        ];
+        for (name, pass) in passes {
+            let t = Instant::now();
+            for _ in 0..n {
+                std::hint::black_box(pass(&sim.model));
+            }
+            let each = t.elapsed().as_secs_f64() / n as Real;
+            out.push(fig(format!("{name}, {threads} thread(s)"), 1.0 / each, "passes/s"));
+            out.push(fig(format!("{name}: one pass, {threads} thread(s)"), each / step, "whole steps"));
+        }
+        Ok(out)
+    })
+}
+
 /// Internal-force assembly: the production gather (each particle sums its
 /// own entries in fixed order) against a scatter into per-thread force
 /// buffers reduced at the end (the usual alternative; not bit-identical

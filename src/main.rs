@@ -1106,6 +1106,11 @@ fn bench(name: &str, steps: usize, whole: Option<f64>, set: &[String]) -> Result
             show(&f);
         }
     }
+    for threads in [1, all] {
+        for f in bench::diagnostics(&case, threads, steps)? {
+            show(&f);
+        }
+    }
     // Timed 5 us into the impact, when the zone under the projectile flows and heats.
     for f in bench::material_floor(&case, 1, 5e-6, steps.min(50))? {
         show(&f);
