@@ -58,3 +58,18 @@ fn material_floor_times_the_case_and_its_elastic_twin() {
     assert!((a.tau - b.tau).norm() <= 1e-12 * scale, "{} vs {}", a.tau, b.tau);
     assert_eq!(a.eps_p, 0.0);
 }
+
+/// The diagnostics workload times the two passes it names, each with its
+/// rate and its cost in whole steps: four positive, finite figures in
+/// that order.
+#[test]
+fn diagnostics_time_the_fastest_particle_and_the_coefficient_gap() {
+    let case = common::small_borvik_nofracture(&[]);
+    let figs = bench::diagnostics(&case, 1, 3).unwrap();
+    assert_eq!(figs.len(), 4);
+    for f in &figs {
+        assert!(f.value.is_finite() && f.value > 0.0, "{f:?}");
+    }
+    assert!(figs[0].name.starts_with("fastest particle") && figs[2].name.starts_with("coefficient gap"));
+    assert_eq!((figs[0].unit, figs[1].unit), ("passes/s", "whole steps"));
+}
