@@ -62,6 +62,16 @@ enum Command {
         #[arg(long)]
         all: bool,
     },
+    /// What a run's stable time step is waiting on: the particles that allow the smallest
+    /// steps in a checkpoint's state, with their mass, the distortion of their points and
+    /// what is left of their material.
+    TimeStep {
+        /// A run's output directory (its newest checkpoint) or a checkpoint file (.ckpt).
+        path: PathBuf,
+        /// How many particles to list.
+        #[arg(long, default_value_t = 10)]
+        top: usize,
+    },
     /// Check a case file without running it: validation, particle counts, time step.
     Check {
         case_file: Option<PathBuf>,
@@ -251,11 +261,9 @@ fn list_cases() -> Result<()> {
 /// `plugsim crack-tips`: the candidates of every growing tip of the
 /// checkpoint at `path` (a file, or a run directory's newest), those
 /// outside the fan too with `all`.
-fn crack_tips(path: &Path, set: &[String], all: bool) -> Result<()> {
-    use plugsim::fracture::CandidateCheck;
-    if let Some(key) = set.iter().find(|s| !s.starts_with("fracture.")) {
-        bail!("--set {key}: crack-tips reads the tips again with other fracture.* parameters only");
-    }
+/// A run's newest checkpoint (`path` its output directory) or the
+/// checkpoint file `path`, with a first line saying which and when.
+fn read_checkpoint(path: &Path) -> Result<plugsim::checkpoint::Restored> {
     let restored = if path.is_dir() {
         let (r, warnings) = plugsim::checkpoint::read_latest(path)?;
         for w in warnings {
@@ -265,8 +273,90 @@ fn crack_tips(path: &Path, set: &[String], all: bool) -> Result<()> {
     } else {
         plugsim::checkpoint::read(path)?
     };
+    println!("{} at t = {:.3} us (step {})", restored.path.display(), restored.sim.time * 1e6, restored.sim.step);
+    Ok(restored)
+}
+
+/// `plugsim time-step`: the `top` particles that allow the smallest steps
+/// in a checkpoint's state ([`plugsim::stability::step_setters`]).
+fn time_step(path: &Path, top: usize) -> Result<()> {
+    use plugsim::particles::ParticleFlags;
+    let sim = read_checkpoint(path)?.sim;
+    let Some(stable) = sim.stable.as_ref() else {
+        println!("the run has a fixed step ({:.4e} s): nothing sets it", sim.dt);
+        return Ok(());
+    };
+    let m = &sim.model;
+    let (p, base) = (&m.particles, stable.base);
+    println!(
+        "step {:.4e} s = {:.3} of the spacing step {:.4e} s; smallest so far {:.4e} s at {:.3} us (particle {})",
+        sim.dt,
+        sim.dt / base,
+        base,
+        stable.smallest.0,
+        stable.smallest.1 * 1e6,
+        stable.smallest.2
+    );
+    println!(
+        "step alone: the elastic step the particle allows (the run takes the least, times the bulk viscosity's factor); \
+         distortion: its bound over the same with undeformed gradients; J, stretch: least det F and largest in-plane \
+         stretch ratio of its live points; points: all / eroded / fractured"
+    );
+    println!(
+        "{:>9} {:>11} {:>7} {:>11} {:>10} {:>11} {:>6} {:>9} {:>9} {:>12} {:>24} {:>24}  kind",
+        "particle",
+        "step alone",
+        "/ dt0",
+        "distortion",
+        "mass (kg)",
+        "added (kg)",
+        "share",
+        "least J",
+        "stretch",
+        "points",
+        "X (mm)",
+        "x now (mm)"
+    );
+    for s in plugsim::stability::step_setters(m, stable, sim.fractures_points(), top) {
+        let i = s.particle;
+        let x = p.x0[i] + m.particle_shape.interpolate(i, &p.u);
+        let flags = p.flags[i];
+        let kind: Vec<&str> = [
+            (ParticleFlags::CRACK_FACE, "crack face"),
+            (ParticleFlags::DETACHED, "detached"),
+            (ParticleFlags::SLAVE, "slave"),
+            (ParticleFlags::ON_AXIS, "on the axis"),
+        ]
+        .iter()
+        .filter(|(f, _)| flags.has(*f))
+        .map(|&(_, name)| name)
+        .collect();
+        println!(
+            "{i:>9} {:>11.4e} {:>7.3} {:>11.3} {:>10.3e} {:>11.3e} {:>6.3} {:>9.4} {:>9.3} {:>12} {:>24} {:>24}  {}",
+            s.step,
+            s.step / base,
+            s.distortion,
+            s.mass,
+            s.added_mass,
+            plugsim::fracture::growth::live_share(m, i),
+            s.least_j,
+            s.largest_stretch,
+            format!("{} / {} / {}", s.points, s.eroded, s.fractured),
+            format!("({:.4}, {:.4})", p.x0[i].x * 1e3, p.x0[i].y * 1e3),
+            format!("({:.4}, {:.4})", x.x * 1e3, x.y * 1e3),
+            if kind.is_empty() { "-".to_string() } else { kind.join(", ") }
+        );
+    }
+    Ok(())
+}
+
+fn crack_tips(path: &Path, set: &[String], all: bool) -> Result<()> {
+    use plugsim::fracture::CandidateCheck;
+    if let Some(key) = set.iter().find(|s| !s.starts_with("fracture.")) {
+        bail!("--set {key}: crack-tips reads the tips again with other fracture.* parameters only");
+    }
+    let restored = read_checkpoint(path)?;
     let mut sim = restored.sim;
-    println!("{} at t = {:.3} us (step {})", restored.path.display(), sim.time * 1e6, sim.step);
     let Some(cracks) = sim.cracks.as_mut() else {
         println!("the case grows no cracks");
         return Ok(());
@@ -381,6 +471,7 @@ fn dispatch(cmd: Command) -> Result<()> {
             })
         }
         Command::CrackTips { path, set, all } => crack_tips(&path, &set, all),
+        Command::TimeStep { path, top } => time_step(&path, top),
         Command::Resume { dir } => {
             let cfg = RunConfig {
                 out_dir: dir.clone(),

@@ -378,6 +378,89 @@ fn point_modulus(material: &Material, eroded: bool, fractured: Option<(Real, Rea
     }
 }
 
+/// One particle's part in the stable step, for `plugsim time-step`: what
+/// a run's step is waiting on, and why (a light particle, a distorted
+/// row, a failed crumb still carrying pressure).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StepSetter {
+    pub particle: usize,
+    /// The elastic step this particle alone allows, s: `Δt₀ min(1,
+    /// ω_ref / ω_I)` ([`StableStep::evaluate`]; the run's step is the least
+    /// of these, times the bulk viscosity's factor where it damps).
+    pub step: Real,
+    /// `ω_I²` over its bound with the undeformed gradients (the same
+    /// masses, moduli and rows): 1 on an undistorted lattice, the factor
+    /// its points' distortion alone raised it by.
+    pub distortion: Real,
+    /// Its mass, kg (per unit depth in plane strain), and the mass
+    /// scaling added to it.
+    pub mass: Real,
+    pub added_mass: Real,
+    /// The points of its support: how many, how many eroded, how many
+    /// fractured (`D ≥ 1`).
+    pub points: usize,
+    pub eroded: usize,
+    pub fractured: usize,
+    /// Over its live points: the least `J = det F`, and the largest
+    /// in-plane stretch ratio `σ₁/σ₂` of `F` (1 for a pure dilatation; a
+    /// point sheared at constant volume to a stretch `λ` reads `λ²`).
+    pub least_j: Real,
+    pub largest_stretch: Real,
+}
+
+/// The singular-value ratio `σ₁/σ₂ ≥ 1` of the in-plane block of `f`
+/// (infinite for a singular block): from `σ₁² + σ₂² = |F|²` and `σ₁ σ₂ =
+/// |det F|`.
+pub fn stretch_ratio(f: &Block2) -> Real {
+    let sum = f.xx * f.xx + f.xy * f.xy + f.yx * f.yx + f.yy * f.yy;
+    let det = (f.xx * f.yy - f.xy * f.yx).abs();
+    if det == 0.0 {
+        return Real::INFINITY;
+    }
+    let root = (sum * sum - 4.0 * det * det).max(0.0).sqrt();
+    ((sum + root) / (sum - root).max(Real::MIN_POSITIVE)).sqrt()
+}
+
+/// The `top` particles that allow the smallest steps in `model`'s current
+/// configuration, stiffest first (ties by index), for the adaptive step
+/// `stable` (`fracturing` as the run evaluates it:
+/// [`crate::step::Simulation::fractures_points`]).
+pub fn step_setters(model: &Model, stable: &StableStep, fracturing: bool, top: usize) -> Vec<StepSetter> {
+    let deformed = frequency_bounds(model, true, fracturing);
+    let undeformed = frequency_bounds(model, false, fracturing);
+    let mut order: Vec<usize> = (0..deformed.len()).collect();
+    order.sort_by(|&a, &b| deformed[b].total_cmp(&deformed[a]).then(a.cmp(&b)));
+    let (p, quad) = (&model.particles, &model.quad);
+    order
+        .into_iter()
+        .take(top)
+        .map(|i| {
+            let w = deformed[i].sqrt();
+            let step = if w > stable.reference && stable.reference > 0.0 {
+                stable.base * (stable.reference / w)
+            } else {
+                stable.base
+            };
+            let mut points: Vec<usize> = model.gather.range(i).map(|j| model.gather.point[j] as usize).collect();
+            points.sort_unstable();
+            points.dedup();
+            let live = || points.iter().copied().filter(|&q| !quad.eroded[q]);
+            StepSetter {
+                particle: i,
+                step,
+                distortion: if undeformed[i] > 0.0 { deformed[i] / undeformed[i] } else { Real::NAN },
+                mass: p.mass[i],
+                added_mass: p.added_mass[i],
+                points: points.len(),
+                eroded: points.iter().filter(|&&q| quad.eroded[q]).count(),
+                fractured: points.iter().filter(|&&q| crate::material::is_fractured(quad.damage[q])).count(),
+                least_j: live().map(|q| quad.f[q].determinant()).fold(Real::INFINITY, Real::min),
+                largest_stretch: live().map(|q| stretch_ratio(&quad.f[q])).fold(1.0, Real::max),
+            }
+        })
+        .collect()
+}
+
 /// The largest entry of `bounds` and its particle (the first on ties).
 pub fn stiffest(bounds: &[Real]) -> (Real, usize) {
     bounds.iter().enumerate().fold((0.0, 0), |(best, at), (i, &w2)| if w2 > best { (w2, i) } else { (best, at) })

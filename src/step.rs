@@ -520,14 +520,21 @@ impl Simulation {
         }
     }
 
+    /// Whether fractured points carry pressure only (the cracks' criterion
+    /// fractures points): the stable step's bound then takes their bulk
+    /// modulus ([`crate::stability::frequency_bounds`]).
+    pub fn fractures_points(&self) -> bool {
+        self.cracks.as_ref().is_some_and(|c| c.params.fractures_points())
+    }
+
     /// Re-evaluate the stable step now (with the adaptive rule; a fixed
     /// step stays), as the time loop does after every crack change: for a
     /// change of the model made outside the loop.
     pub fn refresh_time_step(&mut self) {
+        let fracturing = self.fractures_points();
         let Some(stable) = self.stable.as_mut() else {
             return;
         };
-        let fracturing = self.cracks.as_ref().is_some_and(|c| c.params.fractures_points());
         let (dt, removed) = stable.evaluate(&mut self.model, self.time, fracturing, self.viscous_damping, self.floors);
         self.energies.mass_scaling += removed;
         self.dt = dt;
@@ -654,7 +661,7 @@ impl Simulation {
         // Erosion of inverted failed points (`crate::fracture` module doc).
         let erosion = self.cracks.as_ref().map(|c| c.params).filter(|p| cracking && p.erode_inverted);
         // Not with the non-local criterion (`FractureParameters::fractures_points`).
-        let fracturing = self.cracks.as_ref().is_some_and(|c| c.params.fractures_points());
+        let fracturing = self.fractures_points();
         // One increment per point (a simulation read from a checkpoint
         // starts with none).
         self.work_scratch.resize(self.model.quad.len(), 0.0);

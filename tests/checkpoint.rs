@@ -586,9 +586,12 @@ fn altered_checkpoints_never_panic_the_reader() {
 /// resume test's periodic one, where a crack grows on after it): each
 /// growing tip with its candidate table, its own faces among them as
 /// "taken"; with `--set fracture.tip_gate="tension"` the same state under
-/// the other gate; a key outside `fracture.*` refused naming it.
+/// the other gate; a key outside `fracture.*` refused naming it. And
+/// `plugsim time-step` reads the same checkpoint: the particles that allow
+/// the smallest steps, as many as asked, the first the one
+/// `stability::step_setters` puts first.
 #[test]
-fn crack_tips_reads_the_growing_tips_of_a_checkpoint() {
+fn crack_tips_and_time_step_read_a_checkpoint() {
     let case = case(BORVIK_FRACTURE, FRACTURE_SETS);
     let dir = scratch("crack-tips");
     let _ = run_until(&case, &dir, FRACTURE_STOP);
@@ -616,4 +619,12 @@ fn crack_tips_reads_the_growing_tips_of_a_checkpoint() {
     assert!(stdout.contains("tip gate Tension") && stdout.contains("read with fracture.tip_gate"), "{stdout}");
     let (ok, _, stderr) = text(&["crack-tips", file, "--set", "time.end=1e-6"]);
     assert!(!ok && stderr.contains("time.end") && stderr.contains("fracture.*"), "{stderr}");
+    let (ok, stdout, stderr) = text(&["time-step", file, "--top", "3"]);
+    assert!(ok, "{stderr}");
+    let sim = checkpoint::read(&periodic).unwrap().sim;
+    let first = plugsim::stability::step_setters(&sim.model, sim.stable.as_ref().unwrap(), sim.fractures_points(), 1);
+    let rows: Vec<&str> = stdout.lines().skip_while(|l| !l.trim_start().starts_with("particle")).skip(1).collect();
+    assert_eq!(rows.len(), 3, "{stdout}");
+    assert_eq!(rows[0].split_whitespace().next(), Some(first[0].particle.to_string().as_str()), "{stdout}");
+    assert!(stdout.contains("of the spacing step"), "{stdout}");
 }

@@ -9,7 +9,7 @@ use plugsim::geometry::GeometryMode;
 use plugsim::material::{Elastic, Material};
 use plugsim::math::{Block2, Real, Vec2};
 use plugsim::model::{BodySetup, Model};
-use plugsim::stability::{frequency_bounds, stiffest_particle, Floors, StableStep};
+use plugsim::stability::{frequency_bounds, step_setters, stiffest_particle, stretch_ratio, Floors, StableStep};
 use plugsim::step::{Simulation, TimeStepRule};
 
 const E: Real = 200e9;
@@ -386,4 +386,49 @@ fn erosion_at_the_floor_removes_a_failed_sliver_and_only_it() {
             assert!(dt < 0.5 * dt0, "D = {damage}: the step {} of the spacing step's", dt / dt0);
         }
     }
+}
+
+/// `plugsim time-step`'s report ([`step_setters`]) against exact answers.
+/// A uniform in-plane compression `F = ½ I` doubles every spatial
+/// gradient, so every particle's bound rises by exactly 4 (its
+/// distortion), the stiffest allows exactly half the spacing step, every
+/// live point reads `J = ¼` and a stretch ratio of 1. A particle at a
+/// hundredth of its mass on the undeformed lattice comes first, with no
+/// distortion, allowing exactly the step the run's own evaluation takes.
+/// The stretch ratio of a simple shear `γ` is `σ₁²` with `σ₁ = γ/2 +
+/// √(1 + γ²/4)`.
+#[test]
+fn the_time_step_report_names_what_sets_the_step() {
+    let mut sim = Simulation::new(plate(9, 6), TimeStepRule::Cfl { safety: 0.5 });
+    let stable = sim.stable.clone().expect("the adaptive step");
+    let n = sim.model.particles.len();
+    let close = |a: Real, b: Real| (a - b).abs() <= 1e-12 * b.abs();
+    for f in sim.model.quad.f.iter_mut() {
+        *f = Block2 { xx: 0.5, xy: 0.0, yx: 0.0, yy: 0.5, zz: 1.0 };
+    }
+    let squeezed = step_setters(&sim.model, &stable, false, n);
+    assert_eq!(squeezed.len(), n);
+    assert!(close(squeezed[0].step, 0.5 * stable.base), "{} of {}", squeezed[0].step, stable.base);
+    for s in &squeezed {
+        assert!(close(s.distortion, 4.0), "particle {}: {}", s.particle, s.distortion);
+        assert!(close(s.least_j, 0.25) && close(s.largest_stretch, 1.0), "{s:?}");
+        assert_eq!((s.eroded, s.fractured, s.added_mass), (0, 0, 0.0));
+    }
+    assert!(squeezed.windows(2).all(|w| w[0].step <= w[1].step), "smallest step first");
+    for f in sim.model.quad.f.iter_mut() {
+        *f = Block2::identity_scaled(1.0);
+    }
+    sim.model.particles.mass[22] /= 100.0;
+    let light = step_setters(&sim.model, &stable, false, 3);
+    assert_eq!(light.len(), 3);
+    assert_eq!(light[0].particle, 22);
+    assert!(close(light[0].distortion, 1.0), "{}", light[0].distortion);
+    sim.refresh_time_step();
+    assert_eq!(sim.dt, light[0].step, "the run's own evaluation");
+    let gamma: Real = 3.0;
+    let s1 = 0.5 * gamma + (1.0 + 0.25 * gamma * gamma).sqrt();
+    let shear = Block2 { xx: 1.0, xy: gamma, yx: 0.0, yy: 1.0, zz: 1.0 };
+    assert!(close(stretch_ratio(&shear), s1 * s1), "{} vs {}", stretch_ratio(&shear), s1 * s1);
+    assert!(close(stretch_ratio(&Block2::identity_scaled(0.3)), 1.0));
+    assert_eq!(stretch_ratio(&Block2 { xx: 1.0, xy: 2.0, yx: 0.5, yy: 1.0, zz: 1.0 }), Real::INFINITY);
 }
