@@ -597,6 +597,16 @@ pub struct Shot {
     /// not record it).
     #[serde(default)]
     pub fastest_particle: Option<crate::step::FastestParticle>,
+    /// The fastest a particle could be thrown when the run's fastest was
+    /// set, m/s, under a rounded, conical or ogival rigid nose: its jet
+    /// bound ([`crate::contact::projectile::Projectile::jet_speed_bound`])
+    /// at the depth `v_i (t − t₀)`, `t₀` the history's last row before the
+    /// first contact (so no shallower than the nose was, and the bound no
+    /// larger than the nose's). `None` for a flat nose, a deformable
+    /// projectile, or a run finished by a build that did not record it: the
+    /// bound is then the free-surface doubling `2 v_i`.
+    #[serde(default)]
+    pub speed_bound: Option<Real>,
 }
 
 impl Shot {
@@ -1078,6 +1088,7 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
         Ok(s) => {
             let name = setup.projectile.name(&case);
             let verdict = s.flights.iter().find(|(n, _)| n == name).map_or(Verdict::NotMoving, |(_, v)| *v);
+            let speed_bound = jet_bound(&case, setup.projectile, speed, s.fastest.time, &dir);
             let shot = Shot {
                 speed,
                 verdict,
@@ -1096,6 +1107,7 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
                 detached: s.detached.len(),
                 detached_particles: s.detached,
                 fastest_particle: Some(s.fastest),
+                speed_bound,
             };
             let kept = FinishedRun { writer: crate::checkpoint::this_writer(), shot: shot.clone() };
             // Not written (a full disk): `--resume` runs it again; the table has it.
@@ -1110,6 +1122,19 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
         }
         Err(e) => Event::Failed { speed, message: e.to_string() },
     }
+}
+
+/// [`Shot::speed_bound`] of a run of `case` at `speed` (m/s), for a record
+/// set at `time` (s), from the run's history in `dir`.
+fn jet_bound(case: &Case, projectile: Projectile, speed: Real, time: Real, dir: &Path) -> Option<Real> {
+    let Projectile::Rigid(k) = projectile else {
+        return None;
+    };
+    let nose = case.rigid_bodies[k].projectile.as_ref()?.projectile()?;
+    nose.edge_speed_ratio(0.0)?;
+    let history = crate::output::read_history(dir).ok()?;
+    let touched = crate::output::first_contact_time(&history, &case.rigid_bodies[k].name)?;
+    Some(nose.jet_speed_bound(speed, speed * (time - touched).max(0.0)))
 }
 
 /// The bracket the finished runs give: the lowest perforating speed, the
@@ -1580,29 +1605,41 @@ pub fn report(header: &str, study: &Study) -> String {
     s
 }
 
+/// The bound a run's fastest particle is held to: the larger of the
+/// free-surface doubling `2 v_i` and the nose's jet bound
+/// ([`Shot::speed_bound`]), m/s.
+pub fn speed_bound(shot: &Shot) -> Real {
+    let doubling = FREE_SURFACE_DOUBLING * shot.speed;
+    shot.speed_bound.map_or(doubling, |b| b.max(doubling))
+}
+
 /// The report's note on the runs whose fastest particle outran
 /// [`FREE_SURFACE_DOUBLING`] times the impact speed (issue #19 item 5: a
 /// particle faster than that was thrown by something other than the
 /// impact's waves; docs/validation.md, "Fastest particle"), naming each
-/// particle; `None` where no run's did.
+/// particle and saying which of them stayed within the rounded nose's jet
+/// bound ([`speed_bound`]); `None` where no run's did.
 pub fn outran_doubling(shots: &[Shot]) -> Option<String> {
-    let fast: Vec<String> = shots
-        .iter()
-        .filter(|x| x.fastest > FREE_SURFACE_DOUBLING * x.speed)
-        .map(|x| {
-            let who = x.fastest_particle.map_or_else(|| format!("{:.1} m/s", x.fastest), |f| f.describe());
-            format!("- at {:.2} m/s ({:.2} v_i): {who}\n", x.speed, x.fastest / x.speed)
-        })
-        .collect();
+    let line = |x: &Shot| {
+        let who = x.fastest_particle.map_or_else(|| format!("{:.1} m/s", x.fastest), |f| f.describe());
+        let jet = match x.speed_bound {
+            Some(b) if x.fastest <= speed_bound(x) => format!(" (within the nose's jet bound, {b:.1} m/s)"),
+            Some(b) => format!(" (past the nose's jet bound too, {b:.1} m/s)"),
+            None => String::new(),
+        };
+        format!("- at {:.2} m/s ({:.2} v_i): {who}{jet}\n", x.speed, x.fastest / x.speed)
+    };
+    let fast: Vec<String> = shots.iter().filter(|x| x.fastest > FREE_SURFACE_DOUBLING * x.speed).map(line).collect();
     (!fast.is_empty()).then(|| {
         format!(
             "Particles faster than the free-surface doubling 2 v_i (an elastic wave at a free face doubles the \
              particle speed, so a particle past it was thrown by something else: a crack-face particle squeezed \
              out, a light particle ringing under a contact; docs/validation.md, \"Fastest particle\"; each run's \
              `history.csv` has `max_particle_speed`, and `output.trace_particles` writes the forces on a particle \
-             at every step). Under a rounded nose the first contact throws a jet ahead of its edge, bounded by \
-             twice the edge's speed rather than 2 v_i (docs/validation.md, \"Three throws traced with \
-             `output.trace_particles`\"):\n\n{}\n",
+             at every step). Under a rounded, conical or ogival nose the first contact throws a jet ahead of its \
+             edge, bounded by twice the edge's speed rather than 2 v_i (`Projectile::jet_speed_bound`, taken at \
+             the depth the nose had when the record was set; docs/validation.md, \"Three throws traced with \
+             `output.trace_particles`\"); a particle within that bound is the jet:\n\n{}\n",
             fast.concat()
         )
     })
@@ -2037,6 +2074,33 @@ pub fn write_files(
 mod tests {
     use super::*;
 
+    /// A run's jet bound: a rounded nose's, at the depth from the history's
+    /// last row before the first contact to the record; none for a flat
+    /// nose, and none for a run whose projectile never touched.
+    #[test]
+    fn a_rounded_nose_bounds_its_jet_from_the_first_contact() {
+        let load = |name: &str| Case::from_str_with(crate::cases::builtin_case(name).unwrap(), name, &[]).unwrap();
+        let (hemi, blunt) = (load("borvik-2002-12mm-hemispherical"), load("borvik-2002-12mm-blunt"));
+        let dir = std::env::temp_dir().join(format!("plugsim-jet-bound-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let write = |contacts: [Real; 3]| {
+            let mut w =
+                crate::io::HistoryWriter::create(&dir.join("history.csv"), &["time", "projectile_contacts"]).unwrap();
+            for (t, c) in [0.0, 1e-7, 2e-7].into_iter().zip(contacts) {
+                w.write_row(&[t, c]).unwrap();
+            }
+        };
+        write([0.0, 0.0, 3.0]);
+        let nose = hemi.rigid_bodies[0].projectile.as_ref().unwrap().projectile().unwrap();
+        let bound = jet_bound(&hemi, Projectile::Rigid(0), 292.1, 1.1e-6, &dir).unwrap();
+        assert_eq!(bound, nose.jet_speed_bound(292.1, 292.1 * 1.0e-6));
+        assert!(bound > 2.0 * 292.1, "a millimetre's tenth deep, the edge outruns the nose: {bound}");
+        assert_eq!(jet_bound(&blunt, Projectile::Rigid(0), 184.5, 1.1e-6, &dir), None);
+        write([0.0, 0.0, 0.0]);
+        assert_eq!(jet_bound(&hemi, Projectile::Rigid(0), 292.1, 1.1e-6, &dir), None);
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
     #[test]
     fn a_study_title_marks_the_overrides() {
         let what = "residual against impact velocity";
@@ -2136,6 +2200,7 @@ mod tests {
             detached: 0,
             detached_particles: vec![],
             fastest_particle: None,
+            speed_bound: None,
             dir: PathBuf::new(),
         }
     }
@@ -2188,6 +2253,19 @@ mod tests {
         let back: FinishedRun = toml::from_str(&older).unwrap();
         assert_eq!(back.shot.fastest_particle, None);
         assert_eq!(back.shot.fastest, 441.2);
+        // Under a rounded nose: a throw within the jet bound is named as
+        // the jet, one past it as past it too.
+        let mut jet = fast.clone();
+        jet.speed_bound = Some(500.0);
+        assert_eq!(speed_bound(&jet), 500.0);
+        assert!(outran_doubling(&[jet.clone()]).unwrap().contains("(2.45 v_i): 441.2 m/s, particle 40608"));
+        assert!(outran_doubling(&[jet.clone()]).unwrap().contains(" (within the nose's jet bound, 500.0 m/s)\n"));
+        jet.speed_bound = Some(400.0);
+        assert!(outran_doubling(&[jet.clone()]).unwrap().contains(" (past the nose's jet bound too, 400.0 m/s)\n"));
+        jet.speed_bound = Some(100.0);
+        assert_eq!(speed_bound(&jet), 360.0, "never under the doubling");
+        let text = toml::to_string(&FinishedRun { writer: "w".into(), shot: jet.clone() }).unwrap();
+        assert_eq!(toml::from_str::<FinishedRun>(&text).unwrap().shot, jet);
     }
 
     /// Runs a limit search against `truth` (the plate holds below

@@ -168,6 +168,8 @@ fn speeds_run_side_by_side_and_the_limit_is_bracketed() {
         assert!(s.out_dir.join(f).exists(), "{f}");
     }
     assert!(study.shots.iter().all(|x| x.dir.join("history.csv").exists()));
+    // A rectangle is no nose: its runs are held to the free-surface doubling.
+    assert!(study.shots.iter().all(|x| x.speed_bound.is_none()), "{:?}", study.shots);
     assert!(events.iter().any(|e| matches!(e, Event::Round { .. })));
     std::fs::remove_dir_all(&s.out_dir).ok();
 }

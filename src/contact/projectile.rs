@@ -131,6 +131,45 @@ impl Projectile {
         matches!(self.nose, NoseShape::Blunt { .. })
     }
 
+    /// How fast the edge of contact runs out over a flat face the nose has
+    /// entered by `depth` (m, from its tip), as a multiple of the
+    /// projectile's speed: the slope `dr/dz` of the nose's profile there,
+    /// the face's own motion neglected. A hemisphere of radius `R` gives
+    /// `(R − δ)/√(2Rδ − δ²)` (about `R/a` with `a` the contact radius),
+    /// unbounded at the first touch; a cone `R/L_n`; 0 on the shank.
+    /// `None` for a flat nose, whose face meets the plate all at once.
+    pub fn edge_speed_ratio(&self, depth: Real) -> Option<Real> {
+        let ln = self.nose_length();
+        match self.nose {
+            NoseShape::Blunt { .. } => None,
+            _ if depth >= ln => Some(0.0),
+            NoseShape::Conical { nose_length } => Some(self.radius() / nose_length),
+            NoseShape::Hemispherical | NoseShape::Ogival { .. } => {
+                // The arc centred on the shoulder's level, `ln` behind the tip.
+                let rho = self.arc_radius().expect("a curved nose");
+                let s = ln - depth.max(0.0);
+                let root = (rho * rho - s * s).max(0.0).sqrt();
+                Some(if root > 0.0 { s / root } else { Real::INFINITY })
+            }
+        }
+    }
+
+    /// The fastest a particle can be thrown by this nose entering a flat
+    /// face at `speed` (m/s), `depth` (m) deep: twice the larger of the
+    /// speed and the contact edge's speed ([`Projectile::edge_speed_ratio`]).
+    /// Twice the speed is the free-surface doubling of an impact's wave;
+    /// under a rounded nose the edge of contact runs out faster than the
+    /// projectile at first, and a collision point that runs subsonically
+    /// throws the material ahead of it as a jet, which in steady jet
+    /// theory leaves at the speed the material enters the collision point,
+    /// so at no more than twice the edge's speed in the plate's frame
+    /// (Walsh, Shreffler & Willig, J. Appl. Phys. 24, 1953;
+    /// docs/validation.md, "Three throws traced with
+    /// `output.trace_particles`").
+    pub fn jet_speed_bound(&self, speed: Real, depth: Real) -> Real {
+        2.0 * speed * self.edge_speed_ratio(depth).map_or(1.0, |k| k.max(1.0))
+    }
+
     /// The right half of the section (`x ≥ 0`), from the tip on the axis
     /// along the nose and the shank to the back face's corner `(R, L)`, in
     /// the body frame (tip at the origin, nose toward −y). Curved noses are
@@ -198,6 +237,46 @@ impl Projectile {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The contact edge's speed is the slope of the nose's own outline: a
+    /// central difference of the radius along the faceted profile (the
+    /// geometry the contact uses, at a fine facet) at depths through each
+    /// nose, against [`Projectile::edge_speed_ratio`]; the closed forms of
+    /// the hemisphere and the cone; no edge speed for a flat face, none on
+    /// the shank; and the jet bound never under the free-surface doubling.
+    #[test]
+    fn the_contact_edge_runs_out_at_the_profiles_slope() {
+        let radius_at = |p: &Projectile, z: Real| -> Real {
+            let prof = p.profile(1e-7);
+            let k = prof.windows(2).position(|w| w[0].y <= z && z <= w[1].y).expect("on the profile");
+            let (a, b) = (prof[k], prof[k + 1]);
+            a.x + (b.x - a.x) * (z - a.y) / (b.y - a.y)
+        };
+        for p in shapes().iter().filter(|p| !p.is_flat()) {
+            let ln = p.nose_length();
+            for f in [0.1, 0.3, 0.5, 0.7, 0.9] {
+                let (z, dz) = (f * ln, 1e-3 * ln);
+                let slope = (radius_at(p, z + dz) - radius_at(p, z - dz)) / (2.0 * dz);
+                let k = p.edge_speed_ratio(z).unwrap();
+                assert!((k - slope).abs() <= 2e-3 * slope.max(1e-3), "{:?} at {f}: {k} vs {slope}", p.nose);
+                assert!(
+                    p.jet_speed_bound(300.0, z) >= 600.0
+                        && (p.jet_speed_bound(300.0, z) - 600.0 * k.max(1.0)).abs() < 1e-9
+                );
+            }
+            assert_eq!(p.edge_speed_ratio(ln), Some(0.0), "the shank");
+        }
+        let hemi = Projectile { diameter: D, length: L, nose: NoseShape::Hemispherical };
+        let (r, d) = (0.5 * D, 0.3e-3);
+        let exact = (r - d) / (2.0 * r * d - d * d).sqrt();
+        assert!((hemi.edge_speed_ratio(d).unwrap() - exact).abs() <= 1e-12 * exact);
+        assert_eq!(hemi.edge_speed_ratio(0.0), Some(Real::INFINITY));
+        let cone = Projectile { nose: NoseShape::Conical { nose_length: 2.0 * D }, ..hemi };
+        assert!((cone.edge_speed_ratio(0.5 * D).unwrap() - 0.25).abs() < 1e-15);
+        assert_eq!(cone.jet_speed_bound(300.0, 0.5 * D), 600.0, "a slender cone: the doubling");
+        let blunt = Projectile { nose: NoseShape::Blunt { edge_radius: 0.0 }, ..hemi };
+        assert_eq!((blunt.edge_speed_ratio(1e-4), blunt.jet_speed_bound(300.0, 1e-4)), (None, 600.0));
+    }
     use crate::contact::{mass_axisymmetric, mass_plane_strain, search_rigid_polygon, RigidBody};
     use std::f64::consts::PI;
 
