@@ -224,7 +224,7 @@ fn main() {
     let code = match pool.install(|| dispatch(cli.command)) {
         Ok(()) => 0,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_line(&e));
             // 130 = 128 + SIGINT, the shell's code for a run stopped by Ctrl-C.
             if matches!(e.downcast_ref::<RunError>(), Some(RunError::Interrupted { .. })) {
                 130
@@ -261,6 +261,21 @@ fn list_cases() -> Result<()> {
 /// `plugsim crack-tips`: the candidates of every growing tip of the
 /// checkpoint at `path` (a file, or a run directory's newest), those
 /// outside the fan too with `all`.
+/// An error and its causes on one line, each cause once: most of the
+/// crate's errors already end with their source's text (`"checkpoint X:
+/// {source}"`), which anyhow's `{:#}` would print a second time.
+fn error_line(e: &anyhow::Error) -> String {
+    let mut line = e.to_string();
+    for cause in e.chain().skip(1) {
+        let text = cause.to_string();
+        if !line.ends_with(&text) {
+            line.push_str(": ");
+            line.push_str(&text);
+        }
+    }
+    line
+}
+
 /// A run's newest checkpoint (`path` its output directory) or the
 /// checkpoint file `path`, with a first line saying which and when.
 fn read_checkpoint(path: &Path) -> Result<plugsim::checkpoint::Restored> {

@@ -582,6 +582,20 @@ fn altered_checkpoints_never_panic_the_reader() {
         .unwrap();
 }
 
+/// A checkpoint that is not there gets one line naming it, with the
+/// system's reason said once (the error's own text already ends with it).
+#[test]
+fn a_missing_checkpoint_is_named_with_its_cause_once() {
+    for command in ["time-step", "crack-tips"] {
+        let out = plugsim(&[command, "/nonexistent/plugsim-test.ckpt"]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        assert!(stderr.starts_with("error: checkpoint /nonexistent/plugsim-test.ckpt: "), "{stderr}");
+        assert_eq!(stderr.matches("os error").count(), 1, "{stderr}");
+    }
+}
+
 /// `plugsim crack-tips` reads the growing tips of a checkpoint (the fracture
 /// resume test's periodic one, where a crack grows on after it): each
 /// growing tip with its candidate table, its own faces among them as
