@@ -258,9 +258,6 @@ fn list_cases() -> Result<()> {
     }
 }
 
-/// `plugsim crack-tips`: the candidates of every growing tip of the
-/// checkpoint at `path` (a file, or a run directory's newest), those
-/// outside the fan too with `all`.
 /// An error and its causes on one line, each cause once: most of the
 /// crate's errors already end with their source's text (`"checkpoint X:
 /// {source}"`), which anyhow's `{:#}` would print a second time.
@@ -365,6 +362,9 @@ fn time_step(path: &Path, top: usize) -> Result<()> {
     Ok(())
 }
 
+/// `plugsim crack-tips`: the candidates of every growing tip of the
+/// checkpoint at `path` (a file, or a run directory's newest), those
+/// outside the fan too with `all`.
 fn crack_tips(path: &Path, set: &[String], all: bool) -> Result<()> {
     use plugsim::fracture::CandidateCheck;
     if let Some(key) = set.iter().find(|s| !s.starts_with("fracture.")) {

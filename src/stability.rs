@@ -435,12 +435,7 @@ pub fn step_setters(model: &Model, stable: &StableStep, fracturing: bool, top: u
         .into_iter()
         .take(top)
         .map(|i| {
-            let w = deformed[i].sqrt();
-            let step = if w > stable.reference && stable.reference > 0.0 {
-                stable.base * (stable.reference / w)
-            } else {
-                stable.base
-            };
+            let step = stable.elastic_step(deformed[i].sqrt());
             let mut points: Vec<usize> = model.gather.range(i).map(|j| model.gather.point[j] as usize).collect();
             points.sort_unstable();
             points.dedup();
@@ -546,6 +541,17 @@ impl StableStep {
         }
     }
 
+    /// The elastic step for a stiffest bound `w` (rad/s): `Δt₀ min(1,
+    /// ω_ref / w)` (module doc), the rule's step while no particle is
+    /// stiffer than the reference lattice's stiffest.
+    pub fn elastic_step(&self, w: Real) -> Real {
+        if w > self.reference && self.reference > 0.0 {
+            self.base * (self.reference / w)
+        } else {
+            self.base
+        }
+    }
+
     /// The stable step of `model` in its current configuration at `time`,
     /// with `damping_ratio` the largest damping ratio of the bulk viscosity
     /// on a full lattice (0 without it; the step is then the elastic one bit
@@ -608,9 +614,7 @@ impl StableStep {
             }
         }
         let (w2, i) = stiffest(&self.scratch.bounds);
-        let w = w2.sqrt();
-        let elastic =
-            if w > self.reference && self.reference > 0.0 { self.base * (self.reference / w) } else { self.base };
+        let elastic = self.elastic_step(w2.sqrt());
         // A light particle's damping ratio grows with its frequency
         // (`crate::bulk_viscosity`, "The stable step").
         let dt = elastic * step_factor(damping_ratio * (self.base / elastic));
