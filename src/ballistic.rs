@@ -602,9 +602,12 @@ pub struct Shot {
     /// bound ([`crate::contact::projectile::Projectile::jet_speed_bound`])
     /// at the depth `v_i (t − t₀)`, `t₀` the history's last row before the
     /// first contact (so no shallower than the nose was, and the bound no
-    /// larger than the nose's). `None` for a flat nose, a deformable
-    /// projectile, or a run finished by a build that did not record it: the
-    /// bound is then the free-surface doubling `2 v_i`.
+    /// larger than the nose's), where the particle was at least half the
+    /// contact's radius from the flight's line (a jet leaves at the
+    /// contact's edge). `None` for a flat nose, a deformable projectile, a
+    /// particle nearer the line (under the nose, on the axis), or a run
+    /// finished by a build that did not record it: the bound is then the
+    /// free-surface doubling `2 v_i`.
     #[serde(default)]
     pub speed_bound: Option<Real>,
 }
@@ -1088,7 +1091,7 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
         Ok(s) => {
             let name = setup.projectile.name(&case);
             let verdict = s.flights.iter().find(|(n, _)| n == name).map_or(Verdict::NotMoving, |(_, v)| *v);
-            let speed_bound = jet_bound(&case, setup.projectile, speed, s.fastest.time, &dir);
+            let speed_bound = jet_bound(&case, setup.projectile, speed, &s.fastest, &dir);
             let shot = Shot {
                 speed,
                 verdict,
@@ -1124,17 +1127,30 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
     }
 }
 
-/// [`Shot::speed_bound`] of a run of `case` at `speed` (m/s), for a record
-/// set at `time` (s), from the run's history in `dir`.
-fn jet_bound(case: &Case, projectile: Projectile, speed: Real, time: Real, dir: &Path) -> Option<Real> {
+/// [`Shot::speed_bound`] of a run of `case` at `speed` (m/s) whose fastest
+/// particle is `fastest`, from the run's history in `dir`.
+fn jet_bound(
+    case: &Case,
+    projectile: Projectile,
+    speed: Real,
+    fastest: &crate::step::FastestParticle,
+    dir: &Path,
+) -> Option<Real> {
     let Projectile::Rigid(k) = projectile else {
         return None;
     };
-    let nose = case.rigid_bodies[k].projectile.as_ref()?.projectile()?;
-    nose.edge_speed_ratio(0.0)?;
+    let spec = case.rigid_bodies[k].projectile.as_ref()?;
+    let nose = spec.projectile()?;
     let history = crate::output::read_history(dir).ok()?;
     let touched = crate::output::first_contact_time(&history, &case.rigid_bodies[k].name)?;
-    Some(nose.jet_speed_bound(speed, speed * (time - touched).max(0.0)))
+    let depth = speed * (fastest.time - touched).max(0.0);
+    // A jet leaves at the contact's edge: a particle nearer the flight's
+    // line than half the contact's radius (under the nose, on the axis)
+    // is held to the doubling.
+    let (line, _) = flight(case, projectile);
+    let off = fastest.position - Vec2::new(spec.tip[0], spec.tip[1]);
+    let from_line = (off - line * off.dot(&line)).norm();
+    (from_line >= 0.5 * nose.contact_radius(depth)?).then(|| nose.jet_speed_bound(speed, depth))
 }
 
 /// The bracket the finished runs give: the lowest perforating speed, the
@@ -2075,8 +2091,10 @@ mod tests {
     use super::*;
 
     /// A run's jet bound: a rounded nose's, at the depth from the history's
-    /// last row before the first contact to the record; none for a flat
-    /// nose, and none for a run whose projectile never touched.
+    /// last row before the first contact to the record, for a particle at
+    /// least half the contact's radius off the axis; none nearer the axis,
+    /// none for a flat nose, and none for a run whose projectile never
+    /// touched.
     #[test]
     fn a_rounded_nose_bounds_its_jet_from_the_first_contact() {
         let load = |name: &str| Case::from_str_with(crate::cases::builtin_case(name).unwrap(), name, &[]).unwrap();
@@ -2092,12 +2110,23 @@ mod tests {
         };
         write([0.0, 0.0, 3.0]);
         let nose = hemi.rigid_bodies[0].projectile.as_ref().unwrap().projectile().unwrap();
-        let bound = jet_bound(&hemi, Projectile::Rigid(0), 292.1, 1.1e-6, &dir).unwrap();
-        assert_eq!(bound, nose.jet_speed_bound(292.1, 292.1 * 1.0e-6));
+        // 1.1 us: 0.29 mm deep, touching out to 2.4 mm.
+        let depth = 292.1 * 1.0e-6;
+        let edge = nose.contact_radius(depth).unwrap();
+        let at = |r: Real| crate::step::FastestParticle {
+            time: 1.1e-6,
+            position: Vec2::new(r, 0.0118),
+            ..crate::step::FastestParticle::default()
+        };
+        let bound = jet_bound(&hemi, Projectile::Rigid(0), 292.1, &at(edge), &dir).unwrap();
+        assert_eq!(bound, nose.jet_speed_bound(292.1, depth));
         assert!(bound > 2.0 * 292.1, "a millimetre's tenth deep, the edge outruns the nose: {bound}");
-        assert_eq!(jet_bound(&blunt, Projectile::Rigid(0), 184.5, 1.1e-6, &dir), None);
+        assert_eq!(jet_bound(&hemi, Projectile::Rigid(0), 292.1, &at(0.6 * edge), &dir), Some(bound));
+        assert_eq!(jet_bound(&hemi, Projectile::Rigid(0), 292.1, &at(0.4 * edge), &dir), None, "under the nose");
+        assert_eq!(jet_bound(&hemi, Projectile::Rigid(0), 292.1, &at(0.0), &dir), None, "on the axis");
+        assert_eq!(jet_bound(&blunt, Projectile::Rigid(0), 184.5, &at(edge), &dir), None);
         write([0.0, 0.0, 0.0]);
-        assert_eq!(jet_bound(&hemi, Projectile::Rigid(0), 292.1, 1.1e-6, &dir), None);
+        assert_eq!(jet_bound(&hemi, Projectile::Rigid(0), 292.1, &at(edge), &dir), None);
         std::fs::remove_dir_all(&dir).ok();
     }
 

@@ -328,7 +328,8 @@ fn a_crack_child_is_traced_from_its_first_step() {
 /// time the run's record of the fastest particle is set (a particle
 /// being thrown now), it must be under `2 max(v, v_edge(t))`, the bound
 /// `Projectile::jet_speed_bound` gives from the nose's own outline (the
-/// one the ballistic report holds runs to); and the record passes `2 v_i`
+/// one the ballistic report holds a run to when its particle is off the
+/// axis by half the contact's radius or more); and the record passes `2 v_i`
 /// (measured: 699 m/s at 3.82 µs from a face particle at r = 4.46 mm,
 /// 0.60 of the bound, the edge taken at `(R − δ)/√(2Rδ − δ²) v`; 0.55
 /// with the approximation `R v / a`; docs/validation.md, "Three throws traced with

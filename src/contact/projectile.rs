@@ -154,6 +154,24 @@ impl Projectile {
         }
     }
 
+    /// The radius of the nose's outline `depth` (m) behind its tip: the
+    /// radius out to which it touches a flat face it has entered that deep
+    /// (the face's own motion neglected); the shank's radius behind the
+    /// nose. `None` for a flat nose, which touches its whole face at once.
+    pub fn contact_radius(&self, depth: Real) -> Option<Real> {
+        let (r, ln) = (self.radius(), self.nose_length());
+        match self.nose {
+            NoseShape::Blunt { .. } => None,
+            _ if depth >= ln => Some(r),
+            NoseShape::Conical { nose_length } => Some(r * depth.max(0.0) / nose_length),
+            NoseShape::Hemispherical | NoseShape::Ogival { .. } => {
+                let rho = self.arc_radius().expect("a curved nose");
+                let s = ln - depth.max(0.0);
+                Some(r - rho + (rho * rho - s * s).max(0.0).sqrt())
+            }
+        }
+    }
+
     /// The fastest a particle can be thrown by this nose entering a flat
     /// face at `speed` (m/s), `depth` (m) deep: twice the larger of the
     /// speed and the contact edge's speed ([`Projectile::edge_speed_ratio`]).
@@ -257,6 +275,8 @@ mod tests {
             for f in [0.1, 0.3, 0.5, 0.7, 0.9] {
                 let (z, dz) = (f * ln, 1e-3 * ln);
                 let slope = (radius_at(p, z + dz) - radius_at(p, z - dz)) / (2.0 * dz);
+                let a = p.contact_radius(z).unwrap();
+                assert!((a - radius_at(p, z)).abs() <= 1e-6 * p.radius(), "{:?} at {f}: {a}", p.nose);
                 let k = p.edge_speed_ratio(z).unwrap();
                 assert!((k - slope).abs() <= 2e-3 * slope.max(1e-3), "{:?} at {f}: {k} vs {slope}", p.nose);
                 assert!(
@@ -276,6 +296,7 @@ mod tests {
         assert_eq!(cone.jet_speed_bound(300.0, 0.5 * D), 600.0, "a slender cone: the doubling");
         let blunt = Projectile { nose: NoseShape::Blunt { edge_radius: 0.0 }, ..hemi };
         assert_eq!((blunt.edge_speed_ratio(1e-4), blunt.jet_speed_bound(300.0, 1e-4)), (None, 600.0));
+        assert_eq!((blunt.contact_radius(1e-4), hemi.contact_radius(2.0 * D)), (None, Some(0.5 * D)));
     }
     use crate::contact::{mass_axisymmetric, mass_plane_strain, search_rigid_polygon, RigidBody};
     use std::f64::consts::PI;
