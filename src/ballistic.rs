@@ -1655,7 +1655,9 @@ pub fn outran_doubling(shots: &[Shot]) -> Option<String> {
              at every step). Under a rounded, conical or ogival nose the first contact throws a jet ahead of its \
              edge, bounded by twice the edge's speed rather than 2 v_i (`Projectile::jet_speed_bound`, taken at \
              the depth the nose had when the record was set; docs/validation.md, \"Three throws traced with \
-             `output.trace_particles`\"); a particle within that bound is the jet:\n\n{}\n",
+             `output.trace_particles`\"). A particle within that bound, off the flight's line by half the \
+             contact's radius or more, is the jet; one nearer the line (under the nose, on the axis) is held to \
+             2 v_i, and its line names no jet bound:\n\n{}\n",
             fast.concat()
         )
     })
