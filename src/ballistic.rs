@@ -1423,7 +1423,7 @@ pub fn tests_differ(reference: &Case, case: &Case) -> Option<String> {
 pub fn table(study: &Study) -> (String, String) {
     let mut md = String::from("| v_i (m/s) | v_r (m/s) | outcome | perforation (us) | plug mass (kg; kg/m in plane strain) | end (us) | fastest particle (m/s) | crack-tip damage (median) | crack-tip hardening (least) | steps | wall (s) |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
     let mut csv = String::from(
-        "v_i_m_s,v_r_m_s,perforated,outcome,perforation_us,plug_mass,end_us,fastest_particle_m_s,tip_damage_median,tip_hardening_min,steps,wall_s,dir\n",
+        "v_i_m_s,v_r_m_s,perforated,outcome,perforation_us,plug_mass,end_us,fastest_particle_m_s,fastest_bound_m_s,tip_damage_median,tip_hardening_min,steps,wall_s,dir\n",
     );
     let opt = |v: Option<Real>, f: &dyn Fn(Real) -> String| v.map_or_else(String::new, f);
     for s in &study.shots {
@@ -1447,12 +1447,13 @@ pub fn table(study: &Study) -> (String, String) {
             s.wall
         ));
         csv.push_str(&format!(
-            "{:.2},{vr},{},{},{perf},{mass},{:.3},{:.1},{tip},{hardening},{},{:.2},{}\n",
+            "{:.2},{vr},{},{},{perf},{mass},{:.3},{:.1},{:.1},{tip},{hardening},{},{:.2},{}\n",
             s.speed,
             s.perforated(),
             s.outcome().replace(',', ";"),
             s.end_time * 1e6,
             s.fastest,
+            speed_bound(s),
             s.steps,
             s.wall,
             s.dir.display()

@@ -164,6 +164,15 @@ fn speeds_run_side_by_side_and_the_limit_is_bracketed() {
     assert_eq!(writes, study.shots.len(), "the table is written after every run");
     let csv = std::fs::read_to_string(s.out_dir.join("ballistic.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + study.shots.len(), "{csv}");
+    // Each run's fastest particle beside the bound it is held to: here, with
+    // no nose, the free-surface doubling.
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let (at_v, at_bound) = (0, header.iter().position(|&c| c == "fastest_bound_m_s").expect("the bound's column"));
+    assert_eq!(header[at_bound - 1], "fastest_particle_m_s");
+    for row in csv.lines().skip(1) {
+        let cells: Vec<f64> = row.split(',').map(|c| c.parse().unwrap_or(f64::NAN)).collect();
+        assert_eq!(format!("{:.1}", cells[at_bound]), format!("{:.1}", 2.0 * cells[at_v]), "{row}");
+    }
     for f in ["ballistic.md", "ballistic.png"] {
         assert!(s.out_dir.join(f).exists(), "{f}");
     }
