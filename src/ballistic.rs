@@ -1091,7 +1091,8 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
         Ok(s) => {
             let name = setup.projectile.name(&case);
             let verdict = s.flights.iter().find(|(n, _)| n == name).map_or(Verdict::NotMoving, |(_, v)| *v);
-            let speed_bound = jet_bound(&case, setup.projectile, speed, &s.fastest, &dir);
+            let touched = s.first_contacts.iter().find(|(n, _)| n == name).and_then(|(_, t)| *t);
+            let speed_bound = jet_bound(&case, setup.projectile, speed, &s.fastest, touched);
             let shot = Shot {
                 speed,
                 verdict,
@@ -1128,21 +1129,21 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
 }
 
 /// [`Shot::speed_bound`] of a run of `case` at `speed` (m/s) whose fastest
-/// particle is `fastest`, from the run's history in `dir`.
+/// particle is `fastest` and whose projectile first touched at `touched`
+/// (s; [`crate::run::RunSummary::first_contacts`], `None`: never).
 fn jet_bound(
     case: &Case,
     projectile: Projectile,
     speed: Real,
     fastest: &crate::step::FastestParticle,
-    dir: &Path,
+    touched: Option<Real>,
 ) -> Option<Real> {
     let Projectile::Rigid(k) = projectile else {
         return None;
     };
     let spec = case.rigid_bodies[k].projectile.as_ref()?;
     let nose = spec.projectile()?;
-    let history = crate::output::read_history(dir).ok()?;
-    let touched = crate::output::first_contact_time(&history, &case.rigid_bodies[k].name)?;
+    let touched = touched?;
     let depth = speed * (fastest.time - touched).max(0.0);
     // A jet leaves at the contact's edge: a particle nearer the flight's
     // line than half the contact's radius (under the nose, on the axis)
@@ -2111,7 +2112,12 @@ mod tests {
                 w.write_row(&[t, c]).unwrap();
             }
         };
+        let touched = || {
+            let history = crate::output::read_history(&dir).unwrap();
+            crate::output::first_contact_times(&history, &["projectile".to_string()])[0].1
+        };
         write([0.0, 0.0, 3.0]);
+        assert_eq!(touched(), Some(1e-7), "the last row before the first contact");
         let nose = hemi.rigid_bodies[0].projectile.as_ref().unwrap().projectile().unwrap();
         // 1.1 us: 0.29 mm deep, touching out to 2.4 mm.
         let depth = 292.1 * 1.0e-6;
@@ -2121,15 +2127,18 @@ mod tests {
             position: Vec2::new(r, 0.0118),
             ..crate::step::FastestParticle::default()
         };
-        let bound = jet_bound(&hemi, Projectile::Rigid(0), 292.1, &at(edge), &dir).unwrap();
+        let bound = jet_bound(&hemi, Projectile::Rigid(0), 292.1, &at(edge), touched()).unwrap();
         assert_eq!(bound, nose.jet_speed_bound(292.1, depth));
         assert!(bound > 2.0 * 292.1, "a millimetre's tenth deep, the edge outruns the nose: {bound}");
-        assert_eq!(jet_bound(&hemi, Projectile::Rigid(0), 292.1, &at(0.6 * edge), &dir), Some(bound));
-        assert_eq!(jet_bound(&hemi, Projectile::Rigid(0), 292.1, &at(0.4 * edge), &dir), None, "under the nose");
-        assert_eq!(jet_bound(&hemi, Projectile::Rigid(0), 292.1, &at(0.0), &dir), None, "on the axis");
-        assert_eq!(jet_bound(&blunt, Projectile::Rigid(0), 184.5, &at(edge), &dir), None);
+        assert_eq!(jet_bound(&hemi, Projectile::Rigid(0), 292.1, &at(0.6 * edge), touched()), Some(bound));
+        assert_eq!(jet_bound(&hemi, Projectile::Rigid(0), 292.1, &at(0.4 * edge), touched()), None, "under the nose");
+        assert_eq!(jet_bound(&hemi, Projectile::Rigid(0), 292.1, &at(0.0), touched()), None, "on the axis");
+        assert_eq!(jet_bound(&blunt, Projectile::Rigid(0), 184.5, &at(edge), touched()), None);
+        write([3.0, 3.0, 3.0]);
+        assert_eq!(touched(), Some(0.0), "in contact from the first row");
         write([0.0, 0.0, 0.0]);
-        assert_eq!(jet_bound(&hemi, Projectile::Rigid(0), 292.1, &at(edge), &dir), None);
+        assert_eq!(touched(), None);
+        assert_eq!(jet_bound(&hemi, Projectile::Rigid(0), 292.1, &at(edge), touched()), None);
         std::fs::remove_dir_all(&dir).ok();
     }
 

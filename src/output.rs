@@ -1130,14 +1130,19 @@ pub fn last_contact_times(table: &crate::io::HistoryTable, rigid_names: &[String
         .collect()
 }
 
-/// When the rigid body `name` first touched anything, from the run's
-/// `history.csv`: the time of the last row before its first row in
-/// contact (no later than the touch), s; 0 if the first row is in contact,
-/// `None` if no row is.
-pub fn first_contact_time(table: &crate::io::HistoryTable, name: &str) -> Option<Real> {
+/// When each rigid body of `rigid_names` first touched anything, from the
+/// run's `history.csv`: the time of the last row before its first row in
+/// contact (no later than the touch), s; 0 if the first row is in
+/// contact, `None` if no row is.
+pub fn first_contact_times(table: &crate::io::HistoryTable, rigid_names: &[String]) -> Vec<(String, Option<Real>)> {
     let time = table.column("time").unwrap_or_default();
-    let first = table.column(&format!("{name}_contacts"))?.iter().position(|&c| c > 0.0)?;
-    Some(if first == 0 { 0.0 } else { time[first - 1] })
+    rigid_names
+        .iter()
+        .map(|n| {
+            let first = table.column(&format!("{n}_contacts")).and_then(|c| c.iter().position(|&c| c > 0.0));
+            (n.clone(), first.map(|k| if k == 0 { 0.0 } else { time[k - 1] }))
+        })
+        .collect()
 }
 
 /// Slaves by exposure, from the run's `history.csv`: the particles admitted

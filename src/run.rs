@@ -212,6 +212,9 @@ pub struct RunSummary {
     pub rigid_velocities: Vec<(String, [Real; 2])>,
     /// Time of each rigid body's last contact (history rows), s.
     pub last_contacts: Vec<(String, Option<Real>)>,
+    /// When each rigid body first touched anything: the last history row
+    /// before its first contact, s ([`crate::output::first_contact_times`]).
+    pub first_contacts: Vec<(String, Option<Real>)>,
     /// How each rigid body's flight ended: perforated with its residual
     /// velocity, held, or undecided ([`crate::residual`], from the history).
     pub flights: Vec<(String, crate::residual::Verdict)>,
@@ -661,6 +664,7 @@ fn time_loop(
         })
     });
     let last_contacts = crate::output::last_contact_times(&history, &names);
+    let first_contacts = crate::output::first_contact_times(&history, &names);
     let perforation = crate::output::perforation_time(&history);
     let through = out.through(&sim).to_vec();
     let flights = case
@@ -693,6 +697,7 @@ fn time_loop(
         separation,
         rigid_velocities,
         last_contacts,
+        first_contacts,
         flights,
         plots,
         particles: sim.model.particles.len(),

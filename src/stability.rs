@@ -436,9 +436,8 @@ pub fn step_setters(model: &Model, stable: &StableStep, fracturing: bool, top: u
         .take(top)
         .map(|i| {
             let step = stable.elastic_step(deformed[i].sqrt());
-            let mut points: Vec<usize> = model.gather.range(i).map(|j| model.gather.point[j] as usize).collect();
-            points.sort_unstable();
-            points.dedup();
+            // Each of its points once (a row holds a particle once).
+            let points: Vec<usize> = model.gather.range(i).map(|j| model.gather.point[j] as usize).collect();
             let live = || points.iter().copied().filter(|&q| !quad.eroded[q]);
             StepSetter {
                 particle: i,

@@ -131,6 +131,27 @@ impl Projectile {
         matches!(self.nose, NoseShape::Blunt { .. })
     }
 
+    /// The nose's outline `depth` (m) behind its tip, `(r, dr/dz)`: its
+    /// radius there and its slope (one evaluation for
+    /// [`Projectile::contact_radius`] and [`Projectile::edge_speed_ratio`]);
+    /// the shank's radius and 0 behind the nose; `None` for a flat nose.
+    fn outline_at(&self, depth: Real) -> Option<(Real, Real)> {
+        let (r, ln) = (self.radius(), self.nose_length());
+        match self.nose {
+            NoseShape::Blunt { .. } => None,
+            _ if depth >= ln => Some((r, 0.0)),
+            NoseShape::Conical { nose_length } => Some((r * depth.max(0.0) / nose_length, r / nose_length)),
+            NoseShape::Hemispherical | NoseShape::Ogival { .. } => {
+                // The arc centred on the shoulder's level, `ln` behind the
+                // tip, `s` ahead of its centre.
+                let rho = self.arc_radius().expect("a curved nose");
+                let s = ln - depth.max(0.0);
+                let root = (rho * rho - s * s).max(0.0).sqrt();
+                Some((r - rho + root, if root > 0.0 { s / root } else { Real::INFINITY }))
+            }
+        }
+    }
+
     /// How fast the edge of contact runs out over a flat face the nose has
     /// entered by `depth` (m, from its tip), as a multiple of the
     /// projectile's speed: the slope `dr/dz` of the nose's profile there,
@@ -139,19 +160,7 @@ impl Projectile {
     /// unbounded at the first touch; a cone `R/L_n`; 0 on the shank.
     /// `None` for a flat nose, whose face meets the plate all at once.
     pub fn edge_speed_ratio(&self, depth: Real) -> Option<Real> {
-        let ln = self.nose_length();
-        match self.nose {
-            NoseShape::Blunt { .. } => None,
-            _ if depth >= ln => Some(0.0),
-            NoseShape::Conical { nose_length } => Some(self.radius() / nose_length),
-            NoseShape::Hemispherical | NoseShape::Ogival { .. } => {
-                // The arc centred on the shoulder's level, `ln` behind the tip.
-                let rho = self.arc_radius().expect("a curved nose");
-                let s = ln - depth.max(0.0);
-                let root = (rho * rho - s * s).max(0.0).sqrt();
-                Some(if root > 0.0 { s / root } else { Real::INFINITY })
-            }
-        }
+        self.outline_at(depth).map(|(_, slope)| slope)
     }
 
     /// The radius of the nose's outline `depth` (m) behind its tip: the
@@ -159,17 +168,7 @@ impl Projectile {
     /// (the face's own motion neglected); the shank's radius behind the
     /// nose. `None` for a flat nose, which touches its whole face at once.
     pub fn contact_radius(&self, depth: Real) -> Option<Real> {
-        let (r, ln) = (self.radius(), self.nose_length());
-        match self.nose {
-            NoseShape::Blunt { .. } => None,
-            _ if depth >= ln => Some(r),
-            NoseShape::Conical { nose_length } => Some(r * depth.max(0.0) / nose_length),
-            NoseShape::Hemispherical | NoseShape::Ogival { .. } => {
-                let rho = self.arc_radius().expect("a curved nose");
-                let s = ln - depth.max(0.0);
-                Some(r - rho + (rho * rho - s * s).max(0.0).sqrt())
-            }
-        }
+        self.outline_at(depth).map(|(radius, _)| radius)
     }
 
     /// The fastest a particle can be thrown by this nose entering a flat
