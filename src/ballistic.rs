@@ -42,7 +42,10 @@
 //! - **Resolutions** ([`at_rows`], [`Rung`]): the same study at several
 //!   particle spacings, a uniform refinement of every deformable body, and
 //!   the table of the limit and the residuals across them with their spread
-//!   ([`ladder_table`]; "converged or it doesn't count").
+//!   ([`ladder_table`]; "converged or it doesn't count"), and how much each
+//!   residual moves with its rung's limit ([`limit_sensitivity`]): a
+//!   residual a few per cent above the limits cannot agree better than
+//!   they do, many times over.
 //!
 //! Runs go side by side on threads of their own, each with its own pool of
 //! worker threads (the solver's results do not depend on the thread count).
@@ -794,6 +797,26 @@ impl RechtIpson {
     pub fn at(&self, v_i: Real) -> Real {
         recht_ipson(v_i, self.a, self.p, self.v_bl)
     }
+}
+
+/// How much the residual velocity at impact speed `v_i` moves with the
+/// ballistic limit on a Recht–Ipson curve of exponent `p` and limit `v_bl`:
+/// the per cent `v_r` changes by when `v_bl` changes by 1 %,
+/// `κ = −(v_bl / v_r) ∂v_r/∂v_bl = v_blᵖ / (v_iᵖ − v_blᵖ)` (the factor `a`
+/// cancels); `None` at or below the limit, where there is no residual.
+///
+/// Near the limit `κ ≈ 1 / (p ε)` at `v_i = v_bl (1 + ε)`: it grows
+/// without bound, so a residual measured a few per cent above a limit
+/// cannot agree across resolutions better than `κ` times their limits do.
+/// At 292.1 m/s on a limit of 285.5 (`p` = 2) `κ` = 21: limits 1 % apart
+/// put the residuals 21 % apart. The ladder table gives it beside each
+/// speed's residuals ([`ladder_table`]), so that a residual's spread is
+/// read against its limit's. Test: `the_residuals_sensitivity_to_the_limit`
+/// (the closed form against a finite difference of the curve, and the
+/// asymptote).
+pub fn limit_sensitivity(v_i: Real, p: Real, v_bl: Real) -> Option<Real> {
+    let (vi, vb) = (v_i.powf(p), v_bl.powf(p));
+    (v_i > v_bl && vi > vb).then(|| vb / (vi - vb))
 }
 
 fn recht_ipson(v_i: Real, a: Real, p: Real, v_bl: Real) -> Real {
@@ -1837,8 +1860,11 @@ fn levels<'a>(rungs: &'a [Rung], speeds: &[Real]) -> Vec<Level<'a>> {
 /// limit, the Recht–Ipson fit, the residual velocity at each of `speeds`
 /// and the projectile's edge against its columns ([`edge_phase`]), then
 /// the spread of each across the rungs (with, for values that are
-/// brackets, the least and most it can be within them: [`spread_within`]), the last
-/// refinement's [`step`] (from the second-finest rung to the finest:
+/// brackets, the least and most it can be within them: [`spread_within`]),
+/// each residual's sensitivity to its rung's limit (Markdown only: the
+/// least and largest over the rungs of [`limit_sensitivity`], from each
+/// bracket's middle and fitted exponent, and the rungs whose limit is at or
+/// above the speed), the last refinement's [`step`] (from the second-finest rung to the finest:
 /// what one more refinement moved, the usual test of a converged result)
 /// and, with three rungs or more, what the three finest say of the answer
 /// at zero spacing ([`richardson`]: the observed order, the extrapolated
@@ -1945,6 +1971,36 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
         md.push_str(&format!(" {} |", spread_cell(&|l| l.residuals[k])));
     }
     md.push_str(" | | |\n");
+    // How far each residual can agree, given the limits (`limit_sensitivity`):
+    // per rung, from its bracket's middle and its fit's exponent (2 without
+    // a fitted one, the fit's own default).
+    md.push_str("| v_r's sensitivity to the limit (% per %) | | | |");
+    for &v in speeds {
+        let mut kappas = Vec::new();
+        let mut under = Vec::new();
+        for r in rungs {
+            let Some((v_bl, _)) = r.study.limit_reading().and_then(|l| l.estimate()) else { continue };
+            let p = r.study.fit.filter(|f| !f.p_fixed).map_or(2.0, |f| f.p);
+            match limit_sensitivity(v, p, v_bl) {
+                Some(k) => kappas.push(k),
+                None => under.push(r.label()),
+            }
+        }
+        let lo = kappas.iter().copied().fold(Real::INFINITY, Real::min);
+        let hi = kappas.iter().copied().fold(Real::NEG_INFINITY, Real::max);
+        let (lo, hi) = (format!("{lo:.1}"), format!("{hi:.1}"));
+        let mut cell = match kappas.len() {
+            0 => String::new(),
+            _ if lo == hi => lo,
+            _ => format!("{lo}–{hi}"),
+        };
+        if !under.is_empty() {
+            let sep = if cell.is_empty() { "" } else { "; " };
+            cell.push_str(&format!("{sep}at or under the limit at {}", under.join(", ")));
+        }
+        md.push_str(&format!(" {} |", if cell.is_empty() { "—".into() } else { cell }));
+    }
+    md.push_str(" | | |\n");
     // The two finest resolutions, by rows (the order given need not be).
     let mut by_rows: Vec<&Level> = levels.iter().collect();
     by_rows.sort_by_key(|l| l.rows());
@@ -2034,7 +2090,10 @@ pub fn write_ladder_files(
     let mut text = format!("# Ballistic study at {}\n\n{header}\n\n{md}\n", ladder_extent(rungs));
     text.push_str(
         "Spread: (max − min) / mean over the resolutions (for bracketed values, with the least and most it can \
-         be within the brackets, relative to the same mean). Step: the change from the second-finest resolution to \
+         be within the brackets, relative to the same mean). Sensitivity to the limit: by how many per cent a \
+         residual moves when its resolution's limit moves by 1 %, v_bl^p / (v_i^p − v_bl^p) on the Recht–Ipson \
+         curve (the bracket's middle; p fitted, else 2), least and largest over the resolutions: residuals at a \
+         speed where it is large cannot agree better than that many times the limits' spread. Step: the change from the second-finest resolution to \
          the finest, relative to the former (for a limit, with the least and most it can be within the two \
          brackets). Richardson (three resolutions or more): from the three finest, the observed order of \
          convergence p, the value extrapolated to zero spacing and the grid convergence index of the finest \
@@ -2777,6 +2836,33 @@ mod tests {
     }
 
     #[test]
+    fn the_residuals_sensitivity_to_the_limit() {
+        // The closed form against a central difference of the curve in v_bl.
+        for &(v, p, v_bl) in &[(292.1, 2.0, 285.5), (298.0, 1.64, 180.0), (200.0, 3.5, 120.0), (173.7, 1.2, 150.0)] {
+            let a = 0.8;
+            let d = 1e-4;
+            let slope = (recht_ipson(v, a, p, v_bl + d) - recht_ipson(v, a, p, v_bl - d)) / (2.0 * d);
+            let fd = -v_bl / recht_ipson(v, a, p, v_bl) * slope;
+            let k = limit_sensitivity(v, p, v_bl).unwrap();
+            assert!((k - fd).abs() < 1e-6 * k.max(1.0), "{v} {p} {v_bl}: {k} against {fd}");
+        }
+        // The hemispherical nose at 292.1 m/s on a 285.5 m/s limit: 21.4.
+        let k = limit_sensitivity(292.1, 2.0, 285.5).unwrap();
+        assert!(
+            (k - 285.5f64.powi(2) / (292.1f64.powi(2) - 285.5f64.powi(2))).abs() < 1e-12 && (k - 21.38).abs() < 0.01
+        );
+        // Near the limit κ → 1 / (p ε).
+        for &p in &[1.0, 2.0, 4.0] {
+            let eps = 1e-5;
+            let k = limit_sensitivity(300.0 * (1.0 + eps), p, 300.0).unwrap();
+            assert!((k * p * eps - 1.0).abs() < 1e-4, "{p}: {}", k * p * eps);
+        }
+        // None at or below the limit.
+        assert_eq!(limit_sensitivity(285.5, 2.0, 285.5), None);
+        assert_eq!(limit_sensitivity(280.0, 2.0, 285.5), None);
+    }
+
+    #[test]
     fn the_ladder_table_gives_the_spread_of_limits_and_residuals() {
         let perf = |v| Verdict::Perforated { residual: v, since: 0.0 };
         let held = Verdict::Held { since: 0.0 };
@@ -2821,6 +2907,15 @@ mod tests {
         assert!(step_row.starts_with("| step 12 → 24 rows |"), "{md}");
         assert!(step_row.contains("| +8.3 % (+6.6 %…+10.1 %) |") && step_row.contains("| +10.0 % |"), "{step_row}");
         assert!(md.contains("| 12 | 1.000 | 120.00 ± 1.00 |"), "{md}");
+        // Each residual's sensitivity to the limit, from the brackets'
+        // middles at p = 2 (no fits): at 200 m/s 120²/(200² − 120²) = 0.5625
+        // and 130²/(200² − 130²) = 0.7316; at 300 m/s 0.1905 and 0.2312.
+        let kappa_row = md.lines().find(|l| l.starts_with("| v_r's sensitivity")).unwrap();
+        assert!(kappa_row.contains("| 0.6–0.7 | 0.2 |"), "{md}");
+        // A speed between the limits: 120²/(125² − 120²) = 11.76 at 12 rows.
+        let (md, _) = ladder_table(&rungs, &[125.0]);
+        let kappa_row = md.lines().find(|l| l.starts_with("| v_r's sensitivity")).unwrap();
+        assert!(kappa_row.contains("| 11.8; at or under the limit at 24 rows |"), "{md}");
         assert_eq!(csv.lines().count(), 3, "{csv}");
         assert!(csv.lines().nth(2).unwrap().starts_with("24,0.500000,130.000,1.000,,,,110.000,250.000,2,"), "{csv}");
         // A held run has no residual to compare: "held", and no spread at that speed.

@@ -285,6 +285,10 @@ fn the_command_runs_the_study_at_each_resolution() {
     }
     let md = std::fs::read_to_string(out.join("convergence.md")).unwrap();
     assert!(md.contains("| 5 | 0.800 |") && md.contains("| 9 | 0.444 |") && md.contains("| spread |"), "{md}");
+    assert!(
+        md.contains("| v_r's sensitivity to the limit (% per %) |") && md.contains("Sensitivity to the limit:"),
+        "{md}"
+    );
     assert!(md.contains("bodies.plate.rectangle.layers=5"), "{md}");
     assert!(md.find("| 5 | 0.800 |") < md.find("| 9 | 0.444 |") && md.contains("| step 5 → 9 rows |"), "{md}");
     assert_eq!(std::fs::read_to_string(out.join("convergence.csv")).unwrap().lines().count(), 3);
