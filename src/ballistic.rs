@@ -1864,8 +1864,9 @@ fn levels<'a>(rungs: &'a [Rung], speeds: &[Real]) -> Vec<Level<'a>> {
 /// each residual's sensitivity to its rung's limit (Markdown only: the
 /// least and largest over the rungs of [`limit_sensitivity`], from each
 /// bracket's middle and fitted exponent, and the rungs whose limit is at or
-/// above the speed), the last refinement's [`step`] (from the second-finest rung to the finest:
-/// what one more refinement moved, the usual test of a converged result)
+/// above the speed), the last refinement's [`step`] (from the
+/// second-finest rung to the finest: what one more refinement moved, the
+/// usual test of a converged result)
 /// and, with three rungs or more, what the three finest say of the answer
 /// at zero spacing ([`richardson`]: the observed order, the extrapolated
 /// value and the finest rung's grid convergence index, or why there is
@@ -2093,8 +2094,8 @@ pub fn write_ladder_files(
          be within the brackets, relative to the same mean). Sensitivity to the limit: by how many per cent a \
          residual moves when its resolution's limit moves by 1 %, v_bl^p / (v_i^p − v_bl^p) on the Recht–Ipson \
          curve (the bracket's middle; p fitted, else 2), least and largest over the resolutions: residuals at a \
-         speed where it is large cannot agree better than that many times the limits' spread. Step: the change from the second-finest resolution to \
-         the finest, relative to the former (for a limit, with the least and most it can be within the two \
+         speed where it is large cannot agree better than that many times the limits' spread. Step: the change \
+         from the second-finest resolution to the finest, relative to the former (for a limit, with the least and most it can be within the two \
          brackets). Richardson (three resolutions or more): from the three finest, the observed order of \
          convergence p, the value extrapolated to zero spacing and the grid convergence index of the finest \
          (1.25 |finest − next| / (r^p − 1) relative to the finest, r the spacing ratio; Celik et al. 2008), given \
