@@ -1973,18 +1973,23 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
     }
     md.push_str(" | | |\n");
     // How far each residual can agree, given the limits (`limit_sensitivity`):
-    // per rung, from its bracket's middle and its fit's exponent (2 without
-    // a fitted one, the fit's own default).
+    // per bracketed rung, from its bracket's middle and its fit's exponent
+    // (2 without a fitted one, the fit's own default).
+    let bracketed: Vec<(String, Real, Real)> = rungs
+        .iter()
+        .filter_map(|r| {
+            let (v_bl, _) = r.study.limit_reading()?.estimate()?;
+            Some((r.label(), v_bl, r.study.fit.filter(|f| !f.p_fixed).map_or(2.0, |f| f.p)))
+        })
+        .collect();
     md.push_str("| v_r's sensitivity to the limit (% per %) | | | |");
     for &v in speeds {
         let mut kappas = Vec::new();
         let mut under = Vec::new();
-        for r in rungs {
-            let Some((v_bl, _)) = r.study.limit_reading().and_then(|l| l.estimate()) else { continue };
-            let p = r.study.fit.filter(|f| !f.p_fixed).map_or(2.0, |f| f.p);
-            match limit_sensitivity(v, p, v_bl) {
+        for (label, v_bl, p) in &bracketed {
+            match limit_sensitivity(v, *p, *v_bl) {
                 Some(k) => kappas.push(k),
-                None => under.push(r.label()),
+                None => under.push(label.as_str()),
             }
         }
         let lo = kappas.iter().copied().fold(Real::INFINITY, Real::min);
@@ -2095,8 +2100,8 @@ pub fn write_ladder_files(
          residual moves when its resolution's limit moves by 1 %, v_bl^p / (v_i^p − v_bl^p) on the Recht–Ipson \
          curve (the bracket's middle; p fitted, else 2), least and largest over the resolutions: residuals at a \
          speed where it is large cannot agree better than that many times the limits' spread. Step: the change \
-         from the second-finest resolution to the finest, relative to the former (for a limit, with the least and most it can be within the two \
-         brackets). Richardson (three resolutions or more): from the three finest, the observed order of \
+         from the second-finest resolution to the finest, relative to the former (for a limit, with the least \
+         and most it can be within the two brackets). Richardson (three resolutions or more): from the three finest, the observed order of \
          convergence p, the value extrapolated to zero spacing and the grid convergence index of the finest \
          (1.25 |finest − next| / (r^p − 1) relative to the finest, r the spacing ratio; Celik et al. 2008), given \
          only when the two steps have one sign and the last is the smaller (else it says why not); a limit's \
