@@ -1114,7 +1114,7 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
         Ok(s) => {
             let name = setup.projectile.name(&case);
             let verdict = s.flights.iter().find(|(n, _)| n == name).map_or(Verdict::NotMoving, |(_, v)| *v);
-            let touched = s.first_contacts.iter().find(|(n, _)| n == name).and_then(|(_, t)| *t);
+            let touched = s.contacts.iter().find(|c| c.name == name).and_then(|c| c.first);
             let speed_bound = jet_bound(&case, setup.projectile, speed, &s.fastest, touched);
             let shot = Shot {
                 speed,
@@ -1153,7 +1153,7 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
 
 /// [`Shot::speed_bound`] of a run of `case` at `speed` (m/s) whose fastest
 /// particle is `fastest` and whose projectile first touched at `touched`
-/// (s; [`crate::run::RunSummary::first_contacts`], `None`: never).
+/// (s; [`crate::run::RunSummary::contacts`], `None`: never).
 fn jet_bound(
     case: &Case,
     projectile: Projectile,
@@ -2179,7 +2179,7 @@ mod tests {
         };
         let touched = || {
             let history = crate::output::read_history(&dir).unwrap();
-            crate::output::first_contact_times(&history, &["projectile".to_string()])[0].1
+            crate::output::contact_times(&history, &["projectile".to_string()])[0].first
         };
         write([0.0, 0.0, 3.0]);
         assert_eq!(touched(), Some(1e-7), "the last row before the first contact");

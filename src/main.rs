@@ -1498,8 +1498,8 @@ fn drive(
         qp_rate,
         s.steps as f64 / s.loop_wall.as_secs_f64().max(1e-9)
     );
-    for ((name, v), (_, last)) in s.rigid_velocities.iter().zip(&s.last_contacts) {
-        let contact = match last {
+    for ((name, v), contacts) in s.rigid_velocities.iter().zip(&s.contacts) {
+        let contact = match contacts.last {
             Some(t) if s.time - t > 1e-9 => format!("last contact of any kind at {:.2} us", t * 1e6),
             Some(_) => "in contact at the end".to_string(),
             None => "never in contact".to_string(),

@@ -1111,36 +1111,37 @@ pub fn perforation_time(table: &crate::io::HistoryTable) -> Option<Real> {
     table.column("perforation_time").and_then(|c| c.last().copied()).filter(|&t| t > 0.0)
 }
 
-/// When each rigid body was last in contact, from the run's `history.csv`
-/// (the `NAME_contacts` column): `(name, time of the last history row with
-/// contacts, if any)`. Read from the history rather than tracked in the
-/// loop, so it is right for resumed runs too. The velocity a body keeps once
-/// its contacts have vanished is what experimenters call its residual
-/// velocity.
-pub fn last_contact_times(table: &crate::io::HistoryTable, rigid_names: &[String]) -> Vec<(String, Option<Real>)> {
-    let time = table.column("time").unwrap_or_default();
-    rigid_names
-        .iter()
-        .map(|n| {
-            let last = table
-                .column(&format!("{n}_contacts"))
-                .and_then(|c| c.iter().zip(time).rev().find(|(c, _)| **c > 0.0).map(|(_, t)| *t));
-            (n.clone(), last)
-        })
-        .collect()
+/// When a rigid body touched anything, read from the run's `history.csv`
+/// (its `NAME_contacts` column) by [`contact_times`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ContactTimes {
+    /// The rigid body's name.
+    pub name: String,
+    /// The last history row before its first row in contact (no later than
+    /// the touch), s; 0 if the first row is in contact, `None` if no row is.
+    pub first: Option<Real>,
+    /// The last history row in contact, s; `None` if no row is. The velocity
+    /// a body keeps once its contacts have vanished is what experimenters
+    /// call its residual velocity.
+    pub last: Option<Real>,
 }
 
-/// When each rigid body of `rigid_names` first touched anything, from the
-/// run's `history.csv`: the time of the last row before its first row in
-/// contact (no later than the touch), s; 0 if the first row is in
-/// contact, `None` if no row is.
-pub fn first_contact_times(table: &crate::io::HistoryTable, rigid_names: &[String]) -> Vec<(String, Option<Real>)> {
+/// When each rigid body of `rigid_names` first and last touched anything,
+/// from the run's `history.csv` ([`ContactTimes`]). Read from the history
+/// rather than tracked in the loop, so it is right for resumed runs too.
+pub fn contact_times(table: &crate::io::HistoryTable, rigid_names: &[String]) -> Vec<ContactTimes> {
     let time = table.column("time").unwrap_or_default();
     rigid_names
         .iter()
         .map(|n| {
-            let first = table.column(&format!("{n}_contacts")).and_then(|c| c.iter().position(|&c| c > 0.0));
-            (n.clone(), first.map(|k| if k == 0 { 0.0 } else { time[k - 1] }))
+            let column = table.column(&format!("{n}_contacts"));
+            let first = column.and_then(|c| c.iter().position(|&c| c > 0.0));
+            let last = column.and_then(|c| c.iter().rposition(|&c| c > 0.0));
+            ContactTimes {
+                name: n.clone(),
+                first: first.map(|k| if k == 0 { 0.0 } else { time[k - 1] }),
+                last: last.map(|k| time[k]),
+            }
         })
         .collect()
 }
@@ -1209,7 +1210,7 @@ mod tests {
     }
 
     #[test]
-    fn last_contact_time_is_the_last_row_with_contacts() {
+    fn contact_times_are_the_rows_around_the_first_and_last_contact() {
         let dir = std::env::temp_dir().join(format!("plugsim-last-contact-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let mut h = HistoryWriter::create(&dir.join("history.csv"), &["time", "p_contacts", "q_contacts"]).unwrap();
@@ -1217,8 +1218,9 @@ mod tests {
             h.write_row(&[t, p, 0.0]).unwrap();
         }
         drop(h);
-        let got = last_contact_times(&read_history(&dir).unwrap(), &["p".into(), "q".into()]);
-        assert_eq!(got, vec![("p".to_string(), Some(3.0)), ("q".to_string(), None)]);
+        let got = contact_times(&read_history(&dir).unwrap(), &["p".into(), "q".into()]);
+        let times = |name: &str, first, last| ContactTimes { name: name.into(), first, last };
+        assert_eq!(got, vec![times("p", Some(0.0), Some(3.0)), times("q", None, None)]);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -210,11 +210,9 @@ pub struct RunSummary {
     pub exposed: crate::output::ExposedSummary,
     /// Velocity of each rigid body at the end, (name, (vx, vy)) m/s.
     pub rigid_velocities: Vec<(String, [Real; 2])>,
-    /// Time of each rigid body's last contact (history rows), s.
-    pub last_contacts: Vec<(String, Option<Real>)>,
-    /// When each rigid body first touched anything: the last history row
-    /// before its first contact, s ([`crate::output::first_contact_times`]).
-    pub first_contacts: Vec<(String, Option<Real>)>,
+    /// When each rigid body first and last touched anything (history rows),
+    /// s ([`crate::output::contact_times`]).
+    pub contacts: Vec<crate::output::ContactTimes>,
     /// How each rigid body's flight ended: perforated with its residual
     /// velocity, held, or undecided ([`crate::residual`], from the history).
     pub flights: Vec<(String, crate::residual::Verdict)>,
@@ -663,8 +661,7 @@ fn time_loop(
             _ => Some((g, t)),
         })
     });
-    let last_contacts = crate::output::last_contact_times(&history, &names);
-    let first_contacts = crate::output::first_contact_times(&history, &names);
+    let contacts = crate::output::contact_times(&history, &names);
     let perforation = crate::output::perforation_time(&history);
     let through = out.through(&sim).to_vec();
     let flights = case
@@ -696,8 +693,7 @@ fn time_loop(
         tip_hardening,
         separation,
         rigid_velocities,
-        last_contacts,
-        first_contacts,
+        contacts,
         flights,
         plots,
         particles: sim.model.particles.len(),

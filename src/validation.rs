@@ -241,7 +241,7 @@ pub fn run_row_with(row: &Row, dir: &Path, full_time: bool, extra: &[String]) ->
     });
     let wall = t.elapsed().as_secs_f64();
     let (verdict, last_contact) = match &result {
-        Ok(s) => (s.flights.first().map(|(_, v)| *v), s.last_contacts.first().and_then(|(_, t)| *t)),
+        Ok(s) => (s.flights.first().map(|(_, v)| *v), s.contacts.first().and_then(|c| c.last)),
         Err(_) => (None, None),
     };
     Outcome { row: row.clone(), result, wall, verdict, last_contact, out_dir: dir }
