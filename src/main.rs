@@ -396,7 +396,9 @@ fn crack_tips(path: &Path, set: &[String], all: bool) -> Result<()> {
     for c in growing {
         let crack = &cracks.cracks[c];
         let tip = crack.tip.expect("growing");
-        let (x0, x) = (model.particles.x0[tip], model.particles.x0[tip] + model.particles.u[tip]);
+        // where the material is now: the field at the tip, not its coefficient
+        let x0 = model.particles.x0[tip];
+        let x = x0 + model.particle_shape.interpolate(tip, &model.particles.u);
         let last = crack.vertices.len();
         println!(
             "\ncrack {c}: tip particle {tip} at X = ({:.4}, {:.4}) mm (now ({:.4}, {:.4}) mm), {} vertices, direction ({:.3}, {:.3})",

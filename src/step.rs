@@ -265,6 +265,17 @@ fn largest_by(n: usize, s2: impl Fn(usize) -> Real + Sync) -> (Real, usize) {
 /// until a change of its shape functions (a split, a detachment) shows
 /// it at once (docs/validation.md, "Three throws traced with
 /// `output.trace_particles`"). A detached particle is its own field: 0.
+///
+/// What a gap can move: not the moments a run reports. The plug's mass and
+/// velocity, a deformable body's sample and the total momentum are sums of
+/// `m_I V_I` and `m_I (X_I + U_I)`, which with row-sum masses (SPEC §4) are
+/// exactly the field's `∫ ρ v dV` and `∫ ρ x dV`, gaps or not (test
+/// `coefficients_off_the_field_leave_its_momentum_and_centre_of_mass_exact`);
+/// the fastest particle and the snapshots read the field. What reads a
+/// coefficient itself: the gap point of the contact spreadings `none` and
+/// `inverse_distance` ([RL10]'s, the paper's mode), the axis wall's choice
+/// of which particles to predict (those whose coefficient lies within two
+/// supports of the axis).
 pub fn coefficient_gap(model: &Model) -> (Real, usize) {
     let (tab, p) = (&model.particle_shape, &model.particles);
     largest_by(p.len(), |i| ((p.u[i] - tab.interpolate(i, &p.u)) / p.spacing[i]).norm_squared())
