@@ -613,6 +613,18 @@ pub struct Shot {
     /// free-surface doubling `2 v_i`.
     #[serde(default)]
     pub speed_bound: Option<Real>,
+    /// The projectile's speed along its flight when the cracks first cut
+    /// a piece out (`perforation`; the first history row at or after it,
+    /// [`crate::residual::speed_along_at`]), m/s; `None` without a cut.
+    /// Not a residual: what the projectile loses after it (to a plug
+    /// still in its way, or a cap of plate it carries) is in `v_r` and not
+    /// here. The ladder table compares it across the rungs beside `v_r`,
+    /// which tells a cut that converges from what follows it
+    /// (docs/validation.md, "The hemispherical residual parted at the cut
+    /// and after it"). A run taken back from a build that did not record
+    /// it reads it from its history ([`finished_run`]).
+    #[serde(default)]
+    pub cut_speed: Option<Real>,
 }
 
 impl Shot {
@@ -1017,7 +1029,12 @@ pub fn finished_run(setup: &Setup, speed: Real) -> Option<(Shot, Option<String>)
     }
     let this = crate::checkpoint::this_writer();
     let note = (run.writer != this).then(|| format!("written by {}, taken back by {this}", run.writer));
-    Some((Shot { dir, ..run.shot }, note))
+    // recorded since the cut speed was: else read from the run's history
+    let cut_speed = run.shot.cut_speed.or_else(|| {
+        let (case, _) = at_speed(&setup.case, setup.projectile, speed, setup.max_time);
+        cut_speed(&dir, &case, setup.projectile, run.shot.perforation)
+    });
+    Some((Shot { dir, cut_speed, ..run.shot }, note))
 }
 
 /// The wall time after which a run reports its progress at its next step
@@ -1116,6 +1133,7 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
             let verdict = s.flights.iter().find(|(n, _)| n == name).map_or(Verdict::NotMoving, |(_, v)| *v);
             let touched = s.contacts.iter().find(|c| c.name == name).and_then(|c| c.first);
             let speed_bound = jet_bound(&case, setup.projectile, speed, &s.fastest, touched);
+            let cut_speed = cut_speed(&dir, &case, setup.projectile, s.perforation);
             let shot = Shot {
                 speed,
                 verdict,
@@ -1135,6 +1153,7 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
                 detached_particles: s.detached,
                 fastest_particle: Some(s.fastest),
                 speed_bound,
+                cut_speed,
             };
             let kept = FinishedRun { writer: crate::checkpoint::this_writer(), shot: shot.clone() };
             // Not written (a full disk): `--resume` runs it again; the table has it.
@@ -1149,6 +1168,14 @@ fn run_one(setup: &Setup, speed: Real, stop: &Arc<AtomicBool>, tx: &mpsc::Sender
         }
         Err(e) => Event::Failed { speed, message: e.to_string() },
     }
+}
+
+/// [`Shot::cut_speed`] of the run of `case` in `dir` (its `history.csv`)
+/// whose cracks first cut a piece out at `perforation` (s).
+fn cut_speed(dir: &Path, case: &Case, projectile: Projectile, perforation: Option<Real>) -> Option<Real> {
+    let history = crate::output::read_history(dir).ok()?;
+    let (direction, _) = flight(case, projectile);
+    crate::residual::speed_along_at(&history, projectile.name(case), direction, perforation?)
 }
 
 /// [`Shot::speed_bound`] of a run of `case` at `speed` (m/s) whose fastest
@@ -1445,23 +1472,25 @@ pub fn tests_differ(reference: &Case, case: &Case) -> Option<String> {
 
 /// The table as (Markdown, CSV).
 pub fn table(study: &Study) -> (String, String) {
-    let mut md = String::from("| v_i (m/s) | v_r (m/s) | outcome | perforation (us) | plug mass (kg; kg/m in plane strain) | end (us) | fastest particle (m/s) | crack-tip damage (median) | crack-tip hardening (least) | steps | wall (s) |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
+    let mut md = String::from("| v_i (m/s) | v_r (m/s) | outcome | perforation (us) | v at the cut (m/s) | plug mass (kg; kg/m in plane strain) | end (us) | fastest particle (m/s) | crack-tip damage (median) | crack-tip hardening (least) | steps | wall (s) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     let mut csv = String::from(
-        "v_i_m_s,v_r_m_s,perforated,outcome,perforation_us,plug_mass,end_us,fastest_particle_m_s,fastest_bound_m_s,tip_damage_median,tip_hardening_min,steps,wall_s,dir\n",
+        "v_i_m_s,v_r_m_s,perforated,outcome,perforation_us,cut_speed_m_s,plug_mass,end_us,fastest_particle_m_s,fastest_bound_m_s,tip_damage_median,tip_hardening_min,steps,wall_s,dir\n",
     );
     let opt = |v: Option<Real>, f: &dyn Fn(Real) -> String| v.map_or_else(String::new, f);
     for s in &study.shots {
         let vr = opt(s.residual(), &|v| format!("{v:.2}"));
         let perf = opt(s.perforation, &|t| format!("{:.2}", t * 1e6));
+        let cut = opt(s.cut_speed, &|v| format!("{v:.2}"));
         let mass = opt(s.plug_mass, &|m| format!("{m:.5}"));
         let tip = opt(s.tip_damage, &|d| format!("{d:.3}"));
         let hardening = opt(s.tip_hardening, &|h| format!("{h:.3}"));
         md.push_str(&format!(
-            "| {:.2} | {} | {} | {} | {} | {:.1} | {:.0} | {} | {} | {} | {:.1} |\n",
+            "| {:.2} | {} | {} | {} | {} | {} | {:.1} | {:.0} | {} | {} | {} | {:.1} |\n",
             s.speed,
             if vr.is_empty() { "—".into() } else { vr.clone() },
             s.outcome(),
             if perf.is_empty() { "—".into() } else { perf.clone() },
+            if cut.is_empty() { "—".into() } else { cut.clone() },
             if mass.is_empty() { "—".into() } else { mass.clone() },
             s.end_time * 1e6,
             s.fastest,
@@ -1471,7 +1500,7 @@ pub fn table(study: &Study) -> (String, String) {
             s.wall
         ));
         csv.push_str(&format!(
-            "{:.2},{vr},{},{},{perf},{mass},{:.3},{:.1},{:.1},{tip},{hardening},{},{:.2},{}\n",
+            "{:.2},{vr},{},{},{perf},{cut},{mass},{:.3},{:.1},{:.1},{tip},{hardening},{},{:.2},{}\n",
             s.speed,
             s.perforated(),
             s.outcome().replace(',', ";"),
@@ -1485,7 +1514,7 @@ pub fn table(study: &Study) -> (String, String) {
     }
     for (v, e) in &study.failures {
         md.push_str(&format!(
-            "| {v:.2} | — | failed: {} | | | | | | | | |\n",
+            "| {v:.2} | — | failed: {} | | | | | | | | | |\n",
             e.lines().next().unwrap_or("").replace('|', "/")
         ));
     }
@@ -1502,7 +1531,10 @@ projectile's speed along its flight fell to 1 % of the impact speed or below (st
 or to 5 % or below with no plug cut out (at most 0.25 % of its energy left): v_r = 0. Each run stops 20 us \
 after either (`time.stop_after_release`); one still undecided at the case's \
 end time goes on, up to `--max-time` (default 3 times the case's end time). A run still undecided at its end \
-counts as perforating if a plug was cut out, else as held. Ballistic limit: \
+counts as perforating if a plug was cut out, else as held. v at the cut: the projectile's speed along its \
+flight when the cracks first cut a piece out (the first history row at or after the perforation time); \
+not a residual: what the projectile loses after it, to a plug still in its way or to plate it carries, is \
+in v_r only. Ballistic limit: \
 between the lowest perforating speed and the highest speed held below it (one held above it marks a zone of \
 mixed results); each search round runs as many speeds as run side by side, evenly spaced inside the \
 bracket, except one round, once three runs perforated, that spreads them over +-0.9 tol around the \
@@ -1794,8 +1826,9 @@ pub fn ladder_extent(rungs: &[Rung]) -> String {
     }
 }
 
-/// What a ladder compares at one resolution ([`levels`]): the limit and
-/// the residual at each speed as (value, half-width).
+/// What a ladder compares at one resolution ([`levels`]): the limit and,
+/// at each speed, the residual and the speed at the cut as (value,
+/// half-width).
 #[derive(Clone, Debug)]
 struct Level<'a> {
     /// The rungs at this resolution (several with `--phases`).
@@ -1803,9 +1836,18 @@ struct Level<'a> {
     /// The bracketed limit: a rung's own, or over the phases their
     /// envelope (the lowest held bound to the highest perforating one).
     limit: Option<(Real, Real)>,
-    /// The residual where every member perforated: a rung's own (half-width
-    /// 0), or over the phases their mean with half their range.
-    residuals: Vec<Option<(Real, Real)>>,
+    /// Per [`column`]: the residual where every member perforated, then
+    /// the projectile's speed at the cut ([`Shot::cut_speed`]) where every
+    /// member cut a piece out; a rung's own (half-width 0), or over the
+    /// phases their mean with half their range.
+    values: Vec<Option<(Real, Real)>>,
+}
+
+/// The speed-dependent columns of the ladder table, in order: `v_r` at
+/// each of the `n` speeds, then the speed at the cut at each. Column `k`
+/// is (speed index, whether it is the cut's).
+fn column(k: usize, n: usize) -> (usize, bool) {
+    (k % n, k >= n)
 }
 
 impl Level<'_> {
@@ -1838,27 +1880,28 @@ fn levels<'a>(rungs: &'a [Rung], speeds: &[Real]) -> Vec<Level<'a>> {
             let members: Vec<&Rung> = rungs.iter().filter(|r| r.rows == n).collect();
             let limits: Option<Vec<(Real, Real)>> =
                 members.iter().map(|r| r.study.limit_reading().and_then(|l| l.estimate())).collect();
-            let residuals = speeds
-                .iter()
-                .map(|&v| {
-                    let at: Option<Vec<Real>> = members
-                        .iter()
-                        .map(|r| r.study.shot_at(v).and_then(Shot::residual).filter(|&x| x > 0.0))
-                        .collect();
+            let values = (0..2 * speeds.len())
+                .map(|k| {
+                    let (i, cut) = column(k, speeds.len());
+                    let value = |s: &Shot| if cut { s.cut_speed } else { s.residual().filter(|&x| x > 0.0) };
+                    let at: Option<Vec<Real>> =
+                        members.iter().map(|r| r.study.shot_at(speeds[i]).and_then(value)).collect();
                     at.map(|x| {
                         let mean = x.iter().sum::<Real>() / x.len() as Real;
                         (mean, envelope(x.iter().map(|&y| (y, 0.0)).collect()).1)
                     })
                 })
                 .collect();
-            Level { members, limit: limits.map(envelope), residuals }
+            Level { members, limit: limits.map(envelope), values }
         })
         .collect()
 }
 
 /// The resolutions side by side, as (Markdown, CSV): per rung the ballistic
-/// limit, the Recht–Ipson fit, the residual velocity at each of `speeds`
-/// and the projectile's edge against its columns ([`edge_phase`]), then
+/// limit, the Recht–Ipson fit, the residual velocity at each of `speeds`,
+/// then the projectile's speed at the cut at each ([`Shot::cut_speed`],
+/// compared like the residuals; it has no sensitivity row) and the
+/// projectile's edge against its columns ([`edge_phase`]), then
 /// the spread of each across the rungs (with, for values that are
 /// brackets, the least and most it can be within them: [`spread_within`]),
 /// each residual's sensitivity to its rung's limit (Markdown only: the
@@ -1886,8 +1929,12 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
         md.push_str(&format!(" v_r at {v:.1} m/s |"));
         csv.push_str(&format!(",v_r_at_{v:.1}"));
     }
+    for v in speeds {
+        md.push_str(&format!(" v at the cut at {v:.1} m/s |"));
+        csv.push_str(&format!(",v_cut_at_{v:.1}"));
+    }
     md.push_str(" runs | wall (s) | edge − column (spacings) |\n|---|---|---|---|");
-    md.push_str(&"---|".repeat(speeds.len() + 3));
+    md.push_str(&"---|".repeat(2 * speeds.len() + 3));
     md.push('\n');
     csv.push_str(",runs,wall_s,edge_offset\n");
     for r in rungs {
@@ -1928,6 +1975,11 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
             });
             csv.push_str(&format!(",{}", vr.map_or(String::new(), |x| format!("{x:.3}"))));
         }
+        for &v in speeds {
+            let cut = st.shot_at(v).and_then(|s| s.cut_speed);
+            md.push_str(&cut.map_or(" — |".into(), |x| format!(" {x:.2} |")));
+            csv.push_str(&format!(",{}", cut.map_or(String::new(), |x| format!("{x:.3}"))));
+        }
         md.push_str(&format!(
             " {} | {wall:.0} | {} |\n",
             st.shots.len(),
@@ -1947,7 +1999,7 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
             l.spacing() * 1e3,
             l.limit.map_or("—".into(), |(v, h)| format!("{v:.2} ± {h:.2}"))
         ));
-        for x in &l.residuals {
+        for x in &l.values {
             md.push_str(&x.map_or(" — |".into(), |(v, h)| format!(" {v:.2} ± {h:.2} |")));
         }
         let runs: usize = l.members.iter().map(|r| r.study.shots.len()).sum();
@@ -1968,8 +2020,8 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
         }
     };
     md.push_str(&format!("| spread | | {} | |", spread_cell(&|l| l.limit)));
-    for k in 0..speeds.len() {
-        md.push_str(&format!(" {} |", spread_cell(&|l| l.residuals[k])));
+    for k in 0..2 * speeds.len() {
+        md.push_str(&format!(" {} |", spread_cell(&|l| l.values[k])));
     }
     md.push_str(" | | |\n");
     // How far each residual can agree, given the limits (`limit_sensitivity`):
@@ -2006,6 +2058,8 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
         }
         md.push_str(&format!(" {} |", if cell.is_empty() { "—".into() } else { cell }));
     }
+    // not a residual: no sensitivity to give
+    md.push_str(&" — |".repeat(speeds.len()));
     md.push_str(" | | |\n");
     // The two finest resolutions, by rows (the order given need not be).
     let mut by_rows: Vec<&Level> = levels.iter().collect();
@@ -2026,8 +2080,8 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
             fine.rows(),
             step_cell(coarse.limit, fine.limit)
         ));
-        for k in 0..speeds.len() {
-            md.push_str(&format!(" {} |", step_cell(coarse.residuals[k], fine.residuals[k])));
+        for k in 0..2 * speeds.len() {
+            md.push_str(&format!(" {} |", step_cell(coarse.values[k], fine.values[k])));
         }
         md.push_str(" | | |\n");
     }
@@ -2044,8 +2098,8 @@ pub fn ladder_table(rungs: &[Rung], speeds: &[Real]) -> (String, String) {
         md.push_str(&format!("| Richardson, {} / {} / {} rows | | ", third.rows(), second.rows(), first.rows()));
         md.push_str(&convergence::describe(ladder(&|l| l.limit).and_then(|l| richardson(&l))));
         md.push_str(" | |");
-        for k in 0..speeds.len() {
-            let rungs = ladder(&|l| l.residuals[k]);
+        for k in 0..2 * speeds.len() {
+            let rungs = ladder(&|l| l.values[k]);
             md.push_str(&format!(" {} |", convergence::describe(rungs.and_then(|l| richardson(&l)))));
         }
         md.push_str(" | | |\n");
@@ -2099,7 +2153,9 @@ pub fn write_ladder_files(
          be within the brackets, relative to the same mean). Sensitivity to the limit: by how many per cent a \
          residual moves when its resolution's limit moves by 1 %, v_bl^p / (v_i^p − v_bl^p) on the Recht–Ipson \
          curve (the bracket's middle; p fitted, else 2), least and largest over the resolutions: residuals at a \
-         speed where it is large cannot agree better than that many times the limits' spread. Step: the change \
+         speed where it is large cannot agree better than that many times the limits' spread. v at the cut: the \
+         projectile's speed when the cracks first cut a piece out, compared like the residuals; where it agrees \
+         across the resolutions and v_r does not, what parts them comes after the cut. Step: the change \
          from the second-finest resolution to the finest, relative to the former (for a limit, with the least \
          and most it can be within the two brackets). Richardson (three resolutions or more): from the three finest, the observed order of \
          convergence p, the value extrapolated to zero spacing and the grid convergence index of the finest \
@@ -2307,6 +2363,7 @@ mod tests {
             detached_particles: vec![],
             fastest_particle: None,
             speed_bound: None,
+            cut_speed: None,
             dir: PathBuf::new(),
         }
     }
@@ -2810,19 +2867,29 @@ mod tests {
                 ..Study::default()
             },
         };
-        let rungs = [
+        let mut rungs = [
             rung(24, 0.0, (118.0, 120.0), 100.0),
             rung(24, 0.5, (124.0, 126.0), 110.0),
             rung(48, 0.0, (119.0, 121.0), 104.0),
             rung(48, 0.5, (121.0, 123.0), 106.0),
         ];
+        // the speeds at the cut: 150 and 160 at 24 rows, 154 and 156 at 48
+        for (r, cut) in rungs.iter_mut().zip([150.0, 160.0, 154.0, 156.0]) {
+            r.study.shots[0].cut_speed = Some(cut);
+        }
         assert_eq!(ladder_extent(&rungs), "2 resolutions at 2 lattice phases");
         assert_eq!(rungs[1].label(), "24 rows, phase +0.50");
         let (md, csv) = ladder_table(&rungs, &[200.0]);
         assert_eq!(csv.lines().count(), 5, "one CSV line per rung: {csv}");
         let line = |start: &str| md.lines().find(|l| l.starts_with(start)).unwrap_or_else(|| panic!("{start}: {md}"));
-        assert!(line("| 24 rows, 2 phases |").contains("| 122.00 ± 4.00 | | 105.00 ± 5.00 | 2 |"), "{md}");
-        assert!(line("| 48 rows, 2 phases |").contains("| 121.00 ± 2.00 | | 105.00 ± 1.00 |"), "{md}");
+        assert!(
+            line("| 24 rows, 2 phases |").contains("| 122.00 ± 4.00 | | 105.00 ± 5.00 | 155.00 ± 5.00 | 2 |"),
+            "{md}"
+        );
+        assert!(line("| 48 rows, 2 phases |").contains("| 121.00 ± 2.00 | | 105.00 ± 1.00 | 155.00 ± 1.00 |"), "{md}");
+        // the cut's envelopes compare as the residuals' do: 155 ± 5 → 155 ±
+        // 1, from (154 − 160)/160 = −3.75 % to (156 − 150)/150 = +4.0 %
+        assert!(line("| step 24 → 48 rows").ends_with("| +0.0 % (-3.8 %…+4.0 %) | | | |"), "{md}");
         // within the brackets: 118–126 and 119–123 overlap, so at least 0,
         // and at most (126 − 118)/121.5 = 6.6 %; the residuals 100–110 and
         // 104–106: 0 and 10/105 = 9.5 %
@@ -2886,7 +2953,21 @@ mod tests {
         };
         let mut rungs = [rung(12, (119.0, 121.0), perf(100.0), 250.0), rung(24, (129.0, 131.0), perf(110.0), 250.0)];
         rungs[0].edge = Some(EdgePhase { edge: 0.01, column: 0.00982, offset: 0.18 });
+        // the speed at the cut, at 200 m/s only
+        rungs[0].study.shots[0].cut_speed = Some(150.0);
+        rungs[1].study.shots[0].cut_speed = Some(156.0);
         let (md, csv) = ladder_table(&rungs, &[200.0, 300.0]);
+        // its columns follow the residuals': 150 → 156 m/s is 6/153 = 3.9 %
+        // apart and a step of +4.0 %; none at 300 m/s, and no sensitivity
+        assert!(md.lines().next().unwrap().contains("| v_r at 300.0 m/s | v at the cut at 200.0 m/s |"), "{md}");
+        assert!(md.lines().nth(2).unwrap().contains("| 250.00 | 150.00 | — |"), "{md}");
+        let cells = |row: &str| -> Vec<String> { row.split('|').map(|c| c.trim().to_string()).collect() };
+        let spread = cells(md.lines().find(|l| l.starts_with("| spread")).unwrap());
+        assert_eq!((spread[7].as_str(), spread[8].as_str()), ("3.9 %", "—"), "{md}");
+        let step = cells(md.lines().last().unwrap());
+        assert_eq!((step[7].as_str(), step[8].as_str()), ("+4.0 %", "—"), "{md}");
+        let kappa = cells(md.lines().find(|l| l.starts_with("| v_r's sensitivity")).unwrap());
+        assert_eq!((kappa[7].as_str(), kappa[8].as_str()), ("—", "—"), "{md}");
         // the edge's phase: given on the first rung, unknown on the second
         assert!(
             md.lines().nth(2).unwrap().ends_with("| +0.18 |") && md.lines().nth(3).unwrap().ends_with("| — |"),
@@ -2923,7 +3004,10 @@ mod tests {
         let kappa_row = md.lines().find(|l| l.starts_with("| v_r's sensitivity")).unwrap();
         assert!(kappa_row.contains("| 11.8; at or under the limit at 24 rows |"), "{md}");
         assert_eq!(csv.lines().count(), 3, "{csv}");
-        assert!(csv.lines().nth(2).unwrap().starts_with("24,0.500000,130.000,1.000,,,,110.000,250.000,2,"), "{csv}");
+        assert!(
+            csv.lines().nth(2).unwrap().starts_with("24,0.500000,130.000,1.000,,,,110.000,250.000,156.000,,2,"),
+            "{csv}"
+        );
         // A held run has no residual to compare: "held", and no spread at that speed.
         let rungs = [rung(12, (119.0, 121.0), held, 250.0), rung(24, (129.0, 131.0), perf(110.0), 250.0)];
         let (md, _) = ladder_table(&rungs, &[200.0]);

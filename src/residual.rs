@@ -292,9 +292,41 @@ pub fn verdict_from_history(
     Some(verdict(samples, impact_speed, plug, through))
 }
 
+/// Rigid body `name`'s speed along its flight direction `flight` (unit) at
+/// the first history row at or after `t` (s), m/s; `None` where the history
+/// has no such row or no such columns. With `t` the time the cracks first
+/// cut a piece out, it is the speed the projectile had when the plate
+/// first let something go ([`crate::ballistic::Shot::cut_speed`]).
+pub fn speed_along_at(table: &crate::io::HistoryTable, name: &str, flight: Vec2, t: Real) -> Option<Real> {
+    let time = table.column("time")?;
+    let (vx, vy) = (table.column(&format!("{name}_vx"))?, table.column(&format!("{name}_vy"))?);
+    let k = time.iter().position(|&x| x >= t)?;
+    Some(vx[k] * flight.x + vy[k] * flight.y)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The speed at a time is the first history row's at or after it,
+    /// projected on the flight; none past the last row or without the
+    /// body's columns.
+    #[test]
+    fn the_speed_at_a_time_is_the_first_row_at_or_after_it() {
+        let dir = std::env::temp_dir().join(format!("plugsim-speed-along-at-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("history.csv");
+        std::fs::write(&path, "time,p_vx,p_vy\n0,0,-300\n1e-6,3,-250\n2e-6,4,-200\n").unwrap();
+        let table = crate::io::HistoryTable::read(&path).unwrap();
+        let down = Vec2::new(0.0, -1.0);
+        assert_eq!(speed_along_at(&table, "p", down, 0.5e-6), Some(250.0));
+        assert_eq!(speed_along_at(&table, "p", down, 1e-6), Some(250.0));
+        let oblique = speed_along_at(&table, "p", Vec2::new(0.6, -0.8), 2e-6).unwrap();
+        assert!((oblique - (0.6 * 4.0 + 0.8 * 200.0)).abs() < 1e-12, "{oblique}");
+        assert_eq!(speed_along_at(&table, "p", down, 3e-6), None);
+        assert_eq!(speed_along_at(&table, "q", down, 0.0), None);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     /// Rows every 0.4 µs: the plate brakes the projectile from 300 m/s for
     /// 10 µs, then `after` gives each later row's (axial force, speed).

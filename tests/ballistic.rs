@@ -151,6 +151,14 @@ fn speeds_run_side_by_side_and_the_limit_is_bracketed() {
     // A plug was cut out by cracks, so each perforating run reports how far
     // along its locus the material was where they grew.
     assert!(perforating.iter().all(|x| x.tip_damage.is_some_and(|d| d > 0.0 && d.is_finite())), "{:?}", study.shots);
+    // Each perforating run's speed at the cut is the projectile's when the
+    // plug came out: below the impact speed, and no lower than where it
+    // leaves (the plate only brakes it).
+    for x in &perforating {
+        let cut = x.cut_speed.unwrap_or_else(|| panic!("a cut and no speed at it: {x:?}"));
+        assert!(cut < x.speed && cut >= x.residual().unwrap() - 1e-9, "{cut} against {x:?}");
+    }
+    assert!(study.shots.iter().filter(|x| x.perforation.is_none()).all(|x| x.cut_speed.is_none()));
     // The small plate's cracks run in material that still hardens, as in
     // the full-size plates (docs/validation.md).
     assert!(perforating.iter().all(|x| x.tip_hardening.is_some_and(|h| h > 0.0 && h.is_finite())), "{:?}", study.shots);
@@ -518,8 +526,8 @@ fn a_resumed_study_continues_the_interrupted_runs_and_takes_back_the_finished() 
     let speed = 300.0;
     let same = |a: &plugsim::ballistic::Shot, b: &plugsim::ballistic::Shot| {
         assert_eq!(
-            (a.verdict, a.perforation, a.plug_mass, a.end_time, a.fastest, a.steps),
-            (b.verdict, b.perforation, b.plug_mass, b.end_time, b.fastest, b.steps)
+            (a.verdict, a.perforation, a.cut_speed, a.plug_mass, a.end_time, a.fastest, a.steps),
+            (b.verdict, b.perforation, b.cut_speed, b.plug_mass, b.end_time, b.fastest, b.steps)
         );
     };
     // Progress reports every 2 us (10 % of the end time), so some come
@@ -613,6 +621,16 @@ fn a_resumed_study_continues_the_interrupted_runs_and_takes_back_the_finished() 
     run_speeds(&s, &[speed], &mut again, &mut |_| Ok(()), &mut |e| events.push(e)).unwrap();
     assert!(matches!(events.as_slice(), [Event::Reused { note: None, .. }]), "{events:?}");
     assert_eq!(again.shots, study.shots, "the whole row, wall time included");
+    // A record from a build that did not keep the speed at the cut: read
+    // from the run's history, the same.
+    let record = dir.join(plugsim::ballistic::SHOT_FILE);
+    let text = std::fs::read_to_string(&record).unwrap();
+    let older: String = text.lines().filter(|l| !l.starts_with("cut_speed")).map(|l| format!("{l}\n")).collect();
+    assert!(older.len() < text.len() && study.shots[0].cut_speed.is_some(), "{text}");
+    std::fs::write(&record, older).unwrap();
+    let mut older_study = Study::default();
+    run_speeds(&s, &[speed], &mut older_study, &mut |_| Ok(()), &mut |_| {}).unwrap();
+    assert_eq!(older_study.shots, study.shots, "the speed at the cut read back from the history");
 
     // Another case (a later max time) or no --resume: runs afresh.
     for (max_time, resume) in [(50.0e-6, true), (20.0e-6, false)] {
