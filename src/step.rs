@@ -273,7 +273,7 @@ fn largest_by(n: usize, s2: impl Fn(usize) -> Real + Sync) -> (Real, usize) {
 /// `coefficients_off_the_field_leave_its_momentum_and_centre_of_mass_exact`);
 /// the fastest particle and the snapshots read the field. What reads a
 /// coefficient itself: the gap point of the contact spreadings `none` and
-/// `inverse_distance` ([RL10]'s, the paper's mode), the axis wall's choice
+/// `inverse_distance` (\[RL10\]'s, the paper's mode), the axis wall's choice
 /// of which particles to predict (those whose coefficient lies within two
 /// supports of the axis).
 pub fn coefficient_gap(model: &Model) -> (Real, usize) {
