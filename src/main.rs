@@ -773,7 +773,8 @@ struct BallisticArgs {
     #[arg(long)]
     projectile: Option<String>,
     /// Runs side by side, at least 1 (default: one per core, one thread
-    /// each).
+    /// each). With --rows or --phases and fewer speeds than jobs (no
+    /// --limit), whole rungs run side by side.
     #[arg(long, value_parser = jobs_count)]
     jobs: Option<usize>,
     /// Experimental points to plot: a CSV with header v_i,v_r (m/s). Default: a built-in
@@ -960,12 +961,32 @@ fn ballistic(
     let out_dir = out.unwrap_or_else(|| Path::new("runs").join(format!("ballistic-{name}")));
     let interrupt = install_interrupt_handler();
     let started = Instant::now();
+    let cores = rayon::current_num_threads().max(1);
+    let jobs = args.jobs.unwrap_or(cores).max(1);
+    let alone = Lane { jobs, threads_per_run: (cores / jobs).max(1), tag: String::new() };
     if grids.is_empty() {
-        let (study, _) = one_study(case, file, set, projectile, &out_dir, &args, &tests, &interrupt, started)?;
+        let (study, _) = one_study(case, file, set, projectile, &out_dir, &args, &tests, &interrupt, started, &alone)?;
         return finish(&study);
     }
-    let mut rungs = Vec::new();
-    for (rows, phase, refined, extra) in grids {
+    // A study with fewer speeds than jobs (and no limit search, whose
+    // rounds use every job) leaves jobs idle: run that many rungs side by
+    // side instead, each with the jobs its speeds use, their progress lines
+    // tagged with the rung. The results are the same bits either way.
+    let per_study = if args.limit { jobs } else { jobs.min(args.speeds().len()).max(1) };
+    let side_by_side = (jobs / per_study).clamp(1, grids.len());
+    let lane = match side_by_side {
+        1 => alone,
+        n => Lane { jobs: per_study, threads_per_run: (cores / (per_study * n)).max(1), tag: String::new() },
+    };
+    let run_rung = |(rows, phase, refined, extra): Grid| -> Result<Rung> {
+        let mine = Lane {
+            tag: match (side_by_side, phase) {
+                (1, _) => String::new(),
+                (_, Some(p)) => format!("{rows} rows, phase {p:+.2}: "),
+                (_, None) => format!("{rows} rows: "),
+            },
+            ..lane.clone()
+        };
         let body = &refined.bodies[plugsim::ballistic::target(&refined).unwrap_or(0)].rectangle;
         let spacing = (body.y_max - body.y_min) / rows as f64;
         let mut dir = out_dir.clone();
@@ -982,9 +1003,28 @@ fn ballistic(
             if extra.is_empty() { String::new() } else { format!(": {}", extra.join(" ")) }
         );
         let all: Vec<String> = set.iter().chain(&extra).cloned().collect();
-        let (study, edge) = one_study(refined, file, &all, projectile, &dir, &args, &tests, &interrupt, started)?;
-        let stop = study.interrupted;
-        rungs.push(Rung { rows, spacing, overrides: extra, edge, phase, study });
+        let (study, edge) =
+            one_study(refined, file, &all, projectile, &dir, &args, &tests, &interrupt, started, &mine)?;
+        Ok(Rung { rows, spacing, overrides: extra, edge, phase, study })
+    };
+    let mut rungs = Vec::new();
+    let mut queue = grids.into_iter().peekable();
+    while queue.peek().is_some() {
+        let batch: Vec<Grid> = queue.by_ref().take(side_by_side).collect();
+        let done: Vec<Result<Rung>> = if batch.len() == 1 {
+            batch.into_iter().map(&run_rung).collect()
+        } else {
+            std::thread::scope(|s| {
+                let running: Vec<_> = batch.into_iter().map(|g| s.spawn(|| run_rung(g))).collect();
+                running.into_iter().map(|h| h.join().unwrap_or_else(|_| bail!("a rung's study panicked"))).collect()
+            })
+        };
+        let mut stop = false;
+        for rung in done {
+            let rung = rung?;
+            stop |= rung.study.interrupted;
+            rungs.push(rung);
+        }
         if stop {
             break;
         }
@@ -1039,6 +1079,21 @@ fn finish(study: &plugsim::ballistic::Study) -> Result<()> {
     Ok(())
 }
 
+/// A resolution and lattice phase of a ladder, to run as one study: its
+/// rows, its phase (`None`: the case's own columns), the case at it and
+/// the overrides that give it.
+type Grid = (usize, Option<f64>, Case, Vec<String>);
+
+/// How one study shares the machine: its runs side by side, the threads
+/// each, and what its progress lines start with ("24 rows, phase +0.25: "
+/// where rungs run side by side, else nothing).
+#[derive(Clone, Debug)]
+struct Lane {
+    jobs: usize,
+    threads_per_run: usize,
+    tag: String,
+}
+
 /// One ballistic study of `case` (the speeds, then the limit if asked) into
 /// `out_dir`: its table, report and plot, printed and written; with the
 /// projectile's edge against the target's columns that its header states
@@ -1054,13 +1109,12 @@ fn one_study(
     tests: &Tests,
     interrupt: &Option<Arc<AtomicBool>>,
     started: Instant,
+    lane: &Lane,
 ) -> Result<(plugsim::ballistic::Study, Option<plugsim::ballistic::EdgePhase>)> {
     use plugsim::ballistic::{find_limit, flight, run_speeds, write_files};
     use plugsim::ballistic::{Event, Setup, Study};
     let (_, impact) = flight(&case, projectile);
-    let cores = rayon::current_num_threads().max(1);
-    let jobs = args.jobs.unwrap_or(cores).max(1);
-    let threads_per_run = (cores / jobs).max(1);
+    let (jobs, threads_per_run, tag) = (lane.jobs, lane.threads_per_run, &lane.tag);
     let max_time = args.max_time.unwrap_or_else(|| plugsim::ballistic::default_max_time(&case));
     std::fs::create_dir_all(out_dir).with_context(|| format!("cannot create {}", out_dir.display()))?;
     let setup = Setup {
@@ -1101,9 +1155,9 @@ fn one_study(
         match e {
             Event::Round { label, speeds } => {
                 let v: Vec<String> = speeds.iter().map(|v| format!("{v:.2}")).collect();
-                eprintln!("[{at:6.0} s] {label}: {} m/s", v.join(", "));
+                eprintln!("[{at:6.0} s] {tag}{label}: {} m/s", v.join(", "));
             }
-            Event::Started { speed } => eprintln!("[{at:6.0} s]   {speed:.2} m/s started"),
+            Event::Started { speed } => eprintln!("[{at:6.0} s]   {tag}{speed:.2} m/s started"),
             Event::Advanced { speed, time, end, along, perforation } => {
                 // what decides a held run (`residual`): the end time is only a bound
                 let held = plugsim::residual::held_below(speed, perforation.is_some());
@@ -1114,16 +1168,16 @@ fn one_study(
                 let along = along
                     .map(|v| format!(", projectile at {v:.1} m/s{cut} (held once under {held:.1}{rule})"))
                     .unwrap_or_default();
-                eprintln!("[{at:6.0} s]   {speed:.2} m/s at {:.1} of {:.1} us{along}", time * 1e6, end * 1e6)
+                eprintln!("[{at:6.0} s]   {tag}{speed:.2} m/s at {:.1} of {:.1} us{along}", time * 1e6, end * 1e6)
             }
             Event::Finished { shot } => eprintln!(
-                "[{at:6.0} s]   {:.2} m/s: {}{} ({:.1} s)",
+                "[{at:6.0} s]   {tag}{:.2} m/s: {}{} ({:.1} s)",
                 shot.speed,
                 shot.outcome(),
                 shot.residual().map(|v| format!(", v_r = {v:.2} m/s")).unwrap_or_default(),
                 shot.wall
             ),
-            Event::Failed { speed, message } => eprintln!("[{at:6.0} s]   {speed:.2} m/s failed: {message}"),
+            Event::Failed { speed, message } => eprintln!("[{at:6.0} s]   {tag}{speed:.2} m/s failed: {message}"),
             Event::Interrupted { paused } => {
                 let along = paused
                     .along
@@ -1133,22 +1187,22 @@ fn one_study(
                     .unwrap_or_default();
                 let cut = paused.perforation.map(|t| format!(", plug cut at {:.1} us", t * 1e6)).unwrap_or_default();
                 eprintln!(
-                    "[{at:6.0} s]   {:.2} m/s interrupted at {:.1} us{along}{cut} (its checkpoint is kept: --resume continues it)",
+                    "[{at:6.0} s]   {tag}{:.2} m/s interrupted at {:.1} us{along}{cut} (its checkpoint is kept: --resume continues it)",
                     paused.speed,
                     paused.time * 1e6
                 )
             }
             Event::Reused { shot, note } => eprintln!(
-                "[{at:6.0} s]   {:.2} m/s: {}{}, finished before: taken back{}",
+                "[{at:6.0} s]   {tag}{:.2} m/s: {}{}, finished before: taken back{}",
                 shot.speed,
                 shot.outcome(),
                 shot.residual().map(|v| format!(", v_r = {v:.2} m/s")).unwrap_or_default(),
                 note.map(|n| format!(" ({n})")).unwrap_or_default()
             ),
             Event::Resumed { speed, time, warnings } => {
-                eprintln!("[{at:6.0} s]   {speed:.2} m/s continues from its checkpoint at {:.1} us", time * 1e6);
+                eprintln!("[{at:6.0} s]   {tag}{speed:.2} m/s continues from its checkpoint at {:.1} us", time * 1e6);
                 for w in warnings {
-                    eprintln!("[{at:6.0} s]   {speed:.2} m/s: warning: {w}");
+                    eprintln!("[{at:6.0} s]   {tag}{speed:.2} m/s: warning: {w}");
                 }
             }
         }

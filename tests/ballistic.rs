@@ -325,6 +325,31 @@ fn the_command_runs_the_study_at_each_resolution() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// With fewer speeds than `--jobs`, the rungs of a ladder run side by side
+/// (each with the jobs its speeds use), their progress lines tagged with
+/// the rung; every run gives the same bits as when they run in turn.
+#[test]
+fn rungs_with_fewer_speeds_than_jobs_run_side_by_side() {
+    let (dir, case) = small_plate_file("side-by-side");
+    let plugsim = |args: &[&str]| ballistic_cli(&case, args);
+    let (alone, together) = (dir.join("in-turn"), dir.join("side-by-side"));
+    for (out, jobs) in [(&alone, "1"), (&together, "2")] {
+        let o = plugsim(&["--rows", "5,9", "--speeds", "500", "--jobs", jobs, "--out", out.to_str().unwrap()]);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{stderr}");
+        let tagged = stderr.contains("5 rows: 500.00 m/s started") && stderr.contains("9 rows: 500.00 m/s started");
+        assert_eq!(tagged, jobs == "2", "{stderr}");
+    }
+    for rows in [5, 9] {
+        let history =
+            |out: &std::path::Path| std::fs::read(out.join(format!("rows-{rows}/v500.00/history.csv"))).unwrap();
+        assert!(history(&alone) == history(&together), "{rows} rows: the same run whichever way");
+    }
+    let md = std::fs::read_to_string(together.join("convergence.md")).unwrap();
+    assert!(md.find("| 5 | 0.800 |") < md.find("| 9 | 0.444 |"), "the rungs in order: {md}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// `plugsim ballistic --phases`: the study at each lattice phase of the
 /// rim, each in its own directory with the edge where asked, and the
 /// envelope over the phases; a grid whose fine zone cannot hold the
