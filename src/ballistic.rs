@@ -1806,12 +1806,17 @@ pub struct Rung {
 }
 
 impl Rung {
-    /// "24 rows", or "24 rows, phase +0.25" with `--phases`.
+    /// "24 rows", or "24 rows, phase +0.25" with `--phases` ([`rung_label`]).
     pub fn label(&self) -> String {
-        match self.phase {
-            Some(p) => format!("{} rows, phase {p:+.2}", self.rows),
-            None => format!("{} rows", self.rows),
-        }
+        rung_label(self.rows, self.phase)
+    }
+}
+
+/// A rung's name: "24 rows", or "24 rows, phase +0.25" at a lattice phase.
+pub fn rung_label(rows: usize, phase: Option<Real>) -> String {
+    match phase {
+        Some(p) => format!("{rows} rows, phase {p:+.2}"),
+        None => format!("{rows} rows"),
     }
 }
 

@@ -979,14 +979,11 @@ fn ballistic(
         n => Lane { jobs: per_study, threads_per_run: (cores / (per_study * n)).max(1), tag: String::new() },
     };
     let run_rung = |(rows, phase, refined, extra): Grid| -> Result<Rung> {
-        let mine = Lane {
-            tag: match (side_by_side, phase) {
-                (1, _) => String::new(),
-                (_, Some(p)) => format!("{rows} rows, phase {p:+.2}: "),
-                (_, None) => format!("{rows} rows: "),
-            },
-            ..lane.clone()
+        let tag = match side_by_side {
+            1 => String::new(),
+            _ => format!("{}: ", plugsim::ballistic::rung_label(rows, phase)),
         };
+        let mine = Lane { tag, ..lane.clone() };
         let body = &refined.bodies[plugsim::ballistic::target(&refined).unwrap_or(0)].rectangle;
         let spacing = (body.y_max - body.y_min) / rows as f64;
         let mut dir = out_dir.clone();
