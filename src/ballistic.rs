@@ -1020,7 +1020,8 @@ fn started_with(case: &Case, dir: &Path) -> bool {
 /// it (its result is that build's).
 pub fn finished_run(setup: &Setup, speed: Real) -> Option<(Shot, Option<String>)> {
     let dir = run_dir(&setup.out_dir, speed);
-    if !started_with(&at_speed(&setup.case, setup.projectile, speed, setup.max_time).0, &dir) {
+    let (case, _) = at_speed(&setup.case, setup.projectile, speed, setup.max_time);
+    if !started_with(&case, &dir) {
         return None;
     }
     let run: FinishedRun = toml::from_str(&std::fs::read_to_string(dir.join(SHOT_FILE)).ok()?).ok()?;
@@ -1030,10 +1031,7 @@ pub fn finished_run(setup: &Setup, speed: Real) -> Option<(Shot, Option<String>)
     let this = crate::checkpoint::this_writer();
     let note = (run.writer != this).then(|| format!("written by {}, taken back by {this}", run.writer));
     // recorded since the cut speed was: else read from the run's history
-    let cut_speed = run.shot.cut_speed.or_else(|| {
-        let (case, _) = at_speed(&setup.case, setup.projectile, speed, setup.max_time);
-        cut_speed(&dir, &case, setup.projectile, run.shot.perforation)
-    });
+    let cut_speed = run.shot.cut_speed.or_else(|| cut_speed(&dir, &case, setup.projectile, run.shot.perforation));
     Some((Shot { dir, cut_speed, ..run.shot }, note))
 }
 
