@@ -871,8 +871,11 @@ impl ContactSystem {
     /// The axis pairs of this step ([`Self::with_axis`]): every particle
     /// off the axis whose contact-free predicted gap point ends the step at
     /// `r < 0`, in particle order. Only particles whose generalized
-    /// position lies within two supports of the axis are predicted (a
-    /// physical point lies within a support of its particle's).
+    /// position lies within two supports of the axis are predicted: a
+    /// particle whose point crosses the axis is missed only if its
+    /// coefficient lies more than two supports from that point. Not
+    /// guaranteed; measured on the runs whose coefficients left the field
+    /// furthest, at [`crate::step::coefficient_gap`].
     fn axis_candidates(&mut self, input: &StepInput, spreading: Spreading) -> Result<(), ContactError> {
         let near_axis = |i: usize| {
             !input.flags[i].has(ParticleFlags::ON_AXIS) && input.x0[i].x + input.u[i].x < 2.0 * input.support[i]
