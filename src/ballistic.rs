@@ -2227,8 +2227,7 @@ mod tests {
     fn a_rounded_nose_bounds_its_jet_from_the_first_contact() {
         let load = |name: &str| Case::from_str_with(crate::cases::builtin_case(name).unwrap(), name, &[]).unwrap();
         let (hemi, blunt) = (load("borvik-2002-12mm-hemispherical"), load("borvik-2002-12mm-blunt"));
-        let dir = std::env::temp_dir().join(format!("plugsim-jet-bound-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::io::test_util::scratch_dir("jet-bound");
         let write = |contacts: [Real; 3]| {
             let mut w =
                 crate::io::HistoryWriter::create(&dir.join("history.csv"), &["time", "projectile_contacts"]).unwrap();
@@ -2712,8 +2711,7 @@ mod tests {
 
     #[test]
     fn experimental_points_need_their_header() {
-        let dir = std::env::temp_dir().join(format!("plugsim-experiments-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::io::test_util::scratch_dir("experiments");
         let path = dir.join("e.csv");
         std::fs::write(&path, "# source\nv_i,v_r\n200.0, 100.5\n150,0 # held\n").unwrap();
         assert_eq!(read_experiments(&path).unwrap(), vec![(200.0, 100.5), (150.0, 0.0)]);

@@ -715,9 +715,7 @@ mod tests {
 
     #[test]
     fn listing_orders_by_step_and_rotation_keeps_the_newest() {
-        let dir = std::env::temp_dir().join(format!("plugsim-ckpt-list-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::io::test_util::scratch_dir("ckpt-list");
         for s in [30, 4, 200] {
             std::fs::write(dir.join(file_name(s)), b"x").unwrap();
         }

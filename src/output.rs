@@ -1211,8 +1211,7 @@ mod tests {
 
     #[test]
     fn contact_times_are_the_rows_around_the_first_and_last_contact() {
-        let dir = std::env::temp_dir().join(format!("plugsim-last-contact-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::io::test_util::scratch_dir("last-contact");
         let mut h = HistoryWriter::create(&dir.join("history.csv"), &["time", "p_contacts", "q_contacts"]).unwrap();
         for (t, p) in [(0.0, 0.0), (1.0, 3.0), (2.0, 0.0), (3.0, 2.0), (4.0, 0.0)] {
             h.write_row(&[t, p, 0.0]).unwrap();
@@ -1226,8 +1225,7 @@ mod tests {
 
     #[test]
     fn perforation_time_is_read_from_the_last_history_row() {
-        let dir = std::env::temp_dir().join(format!("plugsim-perforation-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::io::test_util::scratch_dir("perforation");
         let mut h = HistoryWriter::create(&dir.join("history.csv"), &["time", "perforation_time"]).unwrap();
         for (t, p) in [(0.0, 0.0), (1.0, 0.0), (2.0, 1.7), (3.0, 1.7)] {
             h.write_row(&[t, p]).unwrap();
@@ -1243,8 +1241,7 @@ mod tests {
 
     #[test]
     fn exposed_contacts_span_the_rows_with_pushed_admitted_particles() {
-        let dir = std::env::temp_dir().join(format!("plugsim-exposed-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::io::test_util::scratch_dir("exposed");
         let mut h =
             HistoryWriter::create(&dir.join("history.csv"), &["time", "exposed_slaves", "exposed_contacts"]).unwrap();
         for (t, a, n) in

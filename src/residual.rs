@@ -313,8 +313,7 @@ mod tests {
     /// body's columns.
     #[test]
     fn the_speed_at_a_time_is_the_first_row_at_or_after_it() {
-        let dir = std::env::temp_dir().join(format!("plugsim-speed-along-at-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::io::test_util::scratch_dir("speed-along-at");
         let path = dir.join("history.csv");
         std::fs::write(&path, "time,p_vx,p_vy\n0,0,-300\n1e-6,3,-250\n2e-6,4,-200\n").unwrap();
         let table = crate::io::HistoryTable::read(&path).unwrap();
